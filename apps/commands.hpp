@@ -1,0 +1,26 @@
+// The subcommands of the mlmap CLI. Each adds itself to the CLI11 app and sets the
+// context's action, so main() runs it after parsing and turns errors into exit codes.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace mlmap::cli {
+
+struct Context {
+  bool quiet = false;
+  std::function<int()> run = [] { return 0; };
+};
+
+void addBuildCommand(CLI::App& app, Context& context);
+void addInfoCommand(CLI::App& app, Context& context);
+void addSimulateCommand(CLI::App& app, Context& context);
+
+inline void addCommands(CLI::App& app, Context& context) {
+  addSimulateCommand(app, context);
+  addBuildCommand(app, context);
+  addInfoCommand(app, context);
+}
+
+}  // namespace mlmap::cli

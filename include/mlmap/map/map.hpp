@@ -1,0 +1,50 @@
+// The Map: the ML-map block layer (eRMSM's input) beside an octomap::OcTree that
+// handles occupancy and map fusion. Both layers see the same scans.
+#pragma once
+
+#include <memory>
+
+#include <octomap/OcTree.h>
+
+#include "mlmap/map/ml_map.hpp"
+#include "mlmap/scan.hpp"
+
+namespace mlmap {
+
+struct MapConfig {
+  double cell_size = 0.1;           // m, ML-map resolution (section IV's cell_size)
+  double octree_resolution = 0.0;   // m, OcTree voxel size; 0 = same as cell_size
+  double max_range = -1.0;          // m, rays are cut here for the OcTree; < 0 = no limit
+  bool with_octree = true;          // false builds the block layer only
+};
+
+class Map {
+ public:
+  explicit Map(const MapConfig& config = {});
+
+  // Adds a scan to both layers: its points to the blocks, its rays (from the sensor
+  // origin, clearing free space) to the OcTree.
+  void insertScan(const Scan& scan);
+  void insertIntoBlocks(const Scan& scan);
+  void insertIntoOctree(const Scan& scan);
+
+  // Releases build-time slack: packs the blocks and prunes the OcTree.
+  void compact();
+
+  const MapConfig& config() const { return config_; }
+  const MLMap& blocks() const { return blocks_; }
+  MLMap& blocks() { return blocks_; }
+  bool hasOctree() const { return octree_ != nullptr; }
+  const octomap::OcTree& octree() const { return *octree_; }
+  octomap::OcTree& octree() { return *octree_; }
+
+  // Replaces the OcTree (map readers); its resolution must match the config's.
+  void setOctree(std::unique_ptr<octomap::OcTree> octree);
+
+ private:
+  MapConfig config_;
+  MLMap blocks_;
+  std::unique_ptr<octomap::OcTree> octree_;
+};
+
+}  // namespace mlmap

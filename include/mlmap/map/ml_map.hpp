@@ -1,0 +1,79 @@
+// The Multi-Level map (section IV): a 2D grid of cells, each holding a short list of
+// blocks ordered by height. Cells live in a hash grid, so the map has no fixed bounds.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "mlmap/map/block.hpp"
+#include "mlmap/scan.hpp"
+
+namespace mlmap {
+
+struct MLMapStats {
+  std::size_t cells = 0;
+  std::size_t blocks = 0;
+  std::size_t horizontal_blocks = 0;
+  std::size_t vertical_blocks = 0;
+  std::size_t labelled_blocks = 0;  // blocks with a plane label
+  std::size_t memory_bytes = 0;     // heap bytes held by the block layer
+};
+
+class MLMap {
+ public:
+  explicit MLMap(double cell_size);
+
+  double cellSize() const { return cell_size_; }
+  CellIndex cellOf(double x, double y) const;
+  Eigen::Vector2d cellCenter(CellIndex cell) const;  // (x, y) of the cell's centre
+
+  // Adds one measurement p (world frame) with variance σ_m by the rules of Fig. 3.
+  void insert(const Point& point, double variance);
+  // Adds every point of the scan, moved to the world frame by its pose.
+  void insertScan(const Scan& scan);
+  // Adds a finished block, as a map reader or a merge does, by the same rules: a
+  // horizontal block is fused like a measurement, a vertical one joins the blocks it reaches.
+  void insertBlock(CellIndex cell, const Block& block);
+
+  // The blocks of a cell, lowest first; empty when the cell has none.
+  std::span<const Block> blocks(CellIndex cell) const;
+  std::span<Block> mutableBlocks(CellIndex cell);
+
+  // Cells in a stable order (the order they were first touched).
+  std::size_t cellCount() const { return cells_.size(); }
+  CellIndex cellAt(std::size_t cell_number) const { return cells_[cell_number].index; }
+  std::span<const Block> blocksAt(std::size_t cell_number) const;
+  std::span<Block> mutableBlocksAt(std::size_t cell_number);
+  std::optional<std::size_t> cellNumber(CellIndex cell) const;
+
+  std::size_t blockCount() const { return block_count_; }
+  MLMapStats stats() const;
+
+  // Releases the slack left by cells that grew; call after building.
+  void compact();
+
+ private:
+  struct Cell {
+    CellIndex index;
+    std::uint32_t first = 0;     // into blocks_
+    std::uint16_t count = 0;
+    std::uint16_t capacity = 0;
+  };
+
+  std::size_t findOrCreateCell(CellIndex cell);
+  void growCell(Cell& cell);
+  void insertIntoCell(std::size_t cell_number, float top, float bottom, float variance);
+  void rehash(std::size_t slot_count);
+
+  double cell_size_;
+  double inverse_cell_size_;
+  std::vector<Cell> cells_;
+  std::vector<Block> blocks_;           // all cells' blocks; each cell owns a run
+  std::vector<std::uint32_t> slots_;    // open-addressing hash of cell numbers
+  std::size_t block_count_ = 0;
+  std::size_t last_cell_ = SIZE_MAX;    // consecutive points of a scan often share a cell
+};
+
+}  // namespace mlmap

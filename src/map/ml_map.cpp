@@ -1,0 +1,269 @@
+#include "mlmap/map/ml_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "mlmap/error.hpp"
+
+namespace mlmap {
+namespace {
+
+constexpr std::uint32_t kEmptySlot = std::numeric_limits<std::uint32_t>::max();
+constexpr std::size_t kMaxBlocksPerCell = std::numeric_limits<std::uint16_t>::max();
+
+std::uint64_t packCell(CellIndex cell) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(cell.i)) << 32) |
+         static_cast<std::uint32_t>(cell.j);
+}
+
+std::size_t slotFor(CellIndex cell, std::size_t mask) {
+  // Fibonacci hashing spreads neighbouring cells over the table.
+  return static_cast<std::size_t>((packCell(cell) * 0x9E3779B97F4A7C15ULL) >> 20) & mask;
+}
+
+// The rules of section IV for a measurement collected by exactly one block:
+// Fig. 3 cases 2, 3 and 5.
+void updateBlock(Block& block, double z, double variance) {
+  const double height = block.height;
+  if (!block.isVertical()) {
+    // The 3σ test gates the innovation (DESIGN.md): the block's own σ shrinks like
+    // σ_m / n, so testing against it alone turns noisy floors vertical.
+    const double gate = 3.0 * std::sqrt(static_cast<double>(block.variance) + variance);
+    if (std::abs(z - height) < gate) {
+      const double sigma = block.variance;
+      block.height = static_cast<float>((variance * height + sigma * z) / (sigma + variance));
+      block.variance = static_cast<float>(sigma * variance / (sigma + variance));
+      return;
+    }
+    block.kind = BlockKind::Vertical;
+    block.depth = static_cast<float>(std::abs(z - height));
+    if (z > height) {
+      block.height = static_cast<float>(z);
+      block.variance = static_cast<float>(variance);
+    }
+    return;
+  }
+  // Vertical: h and σ are those of the highest measurement, d spans down to the lowest.
+  const double bottom = height - block.depth;
+  if (z > height) {
+    block.height = static_cast<float>(z);
+    block.depth = static_cast<float>(z - bottom);
+    block.variance = static_cast<float>(variance);
+  } else if (z < bottom) {
+    block.depth = static_cast<float>(height - z);
+  }
+}
+
+}  // namespace
+
+MLMap::MLMap(double cell_size) : cell_size_(cell_size), inverse_cell_size_(1.0 / cell_size) {
+  if (!(cell_size > 0.0) || !std::isfinite(cell_size)) {
+    throw Error("cell size must be a positive number of metres, got " + std::to_string(cell_size));
+  }
+  slots_.assign(1024, kEmptySlot);
+}
+
+CellIndex MLMap::cellOf(double x, double y) const {
+  const double column = std::floor(x * inverse_cell_size_);
+  const double row = std::floor(y * inverse_cell_size_);
+  constexpr double kLimit = 1 << 30;
+  if (!(std::abs(column) < kLimit && std::abs(row) < kLimit)) {
+    throw Error("point (" + std::to_string(x) + ", " + std::to_string(y) +
+                ") is outside the map's range or not finite");
+  }
+  return {static_cast<std::int32_t>(row), static_cast<std::int32_t>(column)};
+}
+
+Eigen::Vector2d MLMap::cellCenter(CellIndex cell) const {
+  return {(cell.j + 0.5) * cell_size_, (cell.i + 0.5) * cell_size_};
+}
+
+std::optional<std::size_t> MLMap::cellNumber(CellIndex cell) const {
+  const std::size_t mask = slots_.size() - 1;
+  for (std::size_t slot = slotFor(cell, mask);; slot = (slot + 1) & mask) {
+    const std::uint32_t number = slots_[slot];
+    if (number == kEmptySlot) return std::nullopt;
+    if (cells_[number].index == cell) return number;
+  }
+}
+
+void MLMap::rehash(std::size_t slot_count) {
+  slots_.assign(slot_count, kEmptySlot);
+  const std::size_t mask = slot_count - 1;
+  for (std::size_t number = 0; number < cells_.size(); ++number) {
+    std::size_t slot = slotFor(cells_[number].index, mask);
+    while (slots_[slot] != kEmptySlot) slot = (slot + 1) & mask;
+    slots_[slot] = static_cast<std::uint32_t>(number);
+  }
+}
+
+std::size_t MLMap::findOrCreateCell(CellIndex cell) {
+  if (last_cell_ < cells_.size() && cells_[last_cell_].index == cell) return last_cell_;
+  const std::size_t mask = slots_.size() - 1;
+  std::size_t slot = slotFor(cell, mask);
+  for (;; slot = (slot + 1) & mask) {
+    const std::uint32_t number = slots_[slot];
+    if (number == kEmptySlot) break;
+    if (cells_[number].index == cell) return last_cell_ = number;
+  }
+  if (cells_.size() >= kEmptySlot - 1) throw Error("map is full: too many cells");
+  cells_.push_back(Cell{cell, static_cast<std::uint32_t>(blocks_.size()), 0, 0});
+  slots_[slot] = static_cast<std::uint32_t>(cells_.size() - 1);
+  // Keep the load under one half so probes stay short.
+  if (cells_.size() * 2 > slots_.size()) rehash(slots_.size() * 2);
+  return last_cell_ = cells_.size() - 1;
+}
+
+void MLMap::growCell(Cell& cell) {
+  if (cell.capacity >= kMaxBlocksPerCell) throw Error("a cell holds too many blocks");
+  const std::size_t capacity =
+      std::min<std::size_t>(cell.capacity == 0 ? 1 : cell.capacity * 2U, kMaxBlocksPerCell);
+  if (cell.first + cell.capacity == blocks_.size()) {
+    // The cell's run is at the end of the arena: grow it in place.
+    blocks_.resize(cell.first + capacity);
+  } else {
+    const std::size_t first = blocks_.size();
+    blocks_.resize(first + capacity);
+    std::copy_n(blocks_.begin() + cell.first, cell.count, blocks_.begin() + static_cast<long>(first));
+    cell.first = static_cast<std::uint32_t>(first);
+  }
+  if (blocks_.size() > std::numeric_limits<std::uint32_t>::max()) {
+    throw Error("map is full: too many blocks");
+  }
+  cell.capacity = static_cast<std::uint16_t>(capacity);
+}
+
+void MLMap::insertIntoCell(std::size_t cell_number, float top, float bottom, float variance) {
+  Cell& cell = cells_[cell_number];
+  Block* run = blocks_.data() + cell.first;
+  const double reach = cell_size_;
+  // A block collects a measurement when it lies within cell_size of the block's
+  // extent [h − d, h] (DESIGN.md). Blocks are sorted and at least cell_size apart,
+  // so the collectors of [bottom, top] are adjacent in the run.
+  int first_hit = -1;
+  int last_hit = -1;
+  int insert_at = cell.count;
+  for (int k = 0; k < cell.count; ++k) {
+    const Block& block = run[k];
+    if (top > block.bottom() - reach && bottom < block.height + reach) {
+      if (first_hit < 0) first_hit = k;
+      last_hit = k;
+    } else if (top < block.bottom() && insert_at == cell.count) {
+      insert_at = k;
+    }
+  }
+  const bool is_point = top == bottom;
+  if (first_hit >= 0 && first_hit == last_hit && is_point) {
+    updateBlock(run[first_hit], top, variance);
+    return;
+  }
+  if (first_hit >= 0) {
+    // Fig. 3 case 4: the measurement bridges blocks (or spans more than one);
+    // all of them become one vertical block.
+    const Block& lowest = run[first_hit];
+    const Block& highest = run[last_hit];
+    Block merged;
+    merged.kind = BlockKind::Vertical;
+    const bool new_top = top > highest.height;
+    merged.height = new_top ? top : highest.height;
+    merged.variance = new_top ? variance : highest.variance;
+    merged.depth = merged.height - std::min(lowest.bottom(), bottom);
+    run[first_hit] = merged;
+    const int removed = last_hit - first_hit;
+    std::copy(run + last_hit + 1, run + cell.count, run + first_hit + 1);
+    cell.count = static_cast<std::uint16_t>(cell.count - removed);
+    block_count_ -= static_cast<std::size_t>(removed);
+    return;
+  }
+  // Fig. 3 case 1: nobody collects the measurement; a new block.
+  if (cell.count == cell.capacity) {
+    growCell(cell);
+    run = blocks_.data() + cell.first;
+  }
+  std::copy_backward(run + insert_at, run + cell.count, run + cell.count + 1);
+  run[insert_at] = is_point ? Block{top, variance, 0.0F, 0, BlockKind::Horizontal}
+                            : Block{top, variance, top - bottom, 0, BlockKind::Vertical};
+  ++cell.count;
+  ++block_count_;
+}
+
+void MLMap::insert(const Point& point, double variance) {
+  if (!std::isfinite(point.z()) || !(variance > 0.0) || !std::isfinite(variance)) {
+    throw Error("measurement with a non-finite height or a non-positive variance");
+  }
+  const std::size_t cell_number = findOrCreateCell(cellOf(point.x(), point.y()));
+  const auto z = static_cast<float>(point.z());
+  insertIntoCell(cell_number, z, z, static_cast<float>(variance));
+}
+
+void MLMap::insertScan(const Scan& scan) {
+  for (std::size_t index = 0; index < scan.size(); ++index) {
+    insert(scan.worldPoint(index), scan.variance(index));
+  }
+}
+
+void MLMap::insertBlock(CellIndex cell_index, const Block& block) {
+  if (!std::isfinite(block.height) || !std::isfinite(block.depth) || block.depth < 0.0F ||
+      !(block.variance > 0.0F) || !std::isfinite(block.variance)) {
+    throw Error("block with a non-finite height, a negative depth or a non-positive variance");
+  }
+  // A block stands for its measurements: a horizontal one is fused like a point of
+  // its variance, a vertical one joins every block its extent reaches.
+  const float bottom = block.isVertical() ? block.bottom() : block.height;
+  insertIntoCell(findOrCreateCell(cell_index), block.height, bottom, block.variance);
+}
+
+std::span<const Block> MLMap::blocksAt(std::size_t cell_number) const {
+  const Cell& cell = cells_[cell_number];
+  return {blocks_.data() + cell.first, cell.count};
+}
+
+std::span<Block> MLMap::mutableBlocksAt(std::size_t cell_number) {
+  const Cell& cell = cells_[cell_number];
+  return {blocks_.data() + cell.first, cell.count};
+}
+
+std::span<const Block> MLMap::blocks(CellIndex cell) const {
+  const auto number = cellNumber(cell);
+  if (!number) return {};
+  return blocksAt(*number);
+}
+
+std::span<Block> MLMap::mutableBlocks(CellIndex cell) {
+  const auto number = cellNumber(cell);
+  if (!number) return {};
+  return mutableBlocksAt(*number);
+}
+
+MLMapStats MLMap::stats() const {
+  MLMapStats stats;
+  stats.cells = cells_.size();
+  stats.blocks = block_count_;
+  for (const Cell& cell : cells_) {
+    for (const Block& block : blocksAt(static_cast<std::size_t>(&cell - cells_.data()))) {
+      (block.isVertical() ? stats.vertical_blocks : stats.horizontal_blocks)++;
+      if (block.plane != 0) ++stats.labelled_blocks;
+    }
+  }
+  stats.memory_bytes = cells_.capacity() * sizeof(Cell) + blocks_.capacity() * sizeof(Block) +
+                       slots_.capacity() * sizeof(std::uint32_t) + sizeof(*this);
+  return stats;
+}
+
+void MLMap::compact() {
+  std::vector<Block> packed;
+  packed.reserve(block_count_);
+  for (Cell& cell : cells_) {
+    const std::size_t first = packed.size();
+    packed.insert(packed.end(), blocks_.begin() + cell.first,
+                  blocks_.begin() + cell.first + cell.count);
+    cell.first = static_cast<std::uint32_t>(first);
+    cell.capacity = cell.count;
+  }
+  blocks_ = std::move(packed);
+  cells_.shrink_to_fit();
+}
+
+}  // namespace mlmap
