@@ -215,6 +215,34 @@ void MLMap::insertBlock(CellIndex cell_index, const Block& block) {
   insertIntoCell(findOrCreateCell(cell_index), block.height, bottom, block.variance);
 }
 
+void MLMap::restoreCell(CellIndex cell_index, std::span<const Block> blocks) {
+  if (cellNumber(cell_index)) {
+    throw Error("cell (" + std::to_string(cell_index.i) + ", " + std::to_string(cell_index.j) +
+                ") appears twice");
+  }
+  if (blocks.size() > kMaxBlocksPerCell) throw Error("a cell holds too many blocks");
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const Block& block = blocks[k];
+    const bool valid = std::isfinite(block.height) && std::isfinite(block.depth) &&
+                       std::isfinite(block.variance) && block.variance > 0.0F &&
+                       block.depth >= 0.0F &&
+                       (block.isVertical() || block.depth == 0.0F) &&
+                       (block.kind == BlockKind::Horizontal || block.kind == BlockKind::Vertical);
+    // Gaps are compared with a float tolerance: they were computed in float.
+    const bool ordered = k == 0 || block.bottom() - blocks[k - 1].height >= cell_size_ * (1 - 1e-4);
+    if (!valid || !ordered) {
+      throw Error("cell (" + std::to_string(cell_index.i) + ", " + std::to_string(cell_index.j) +
+                  ") block " + std::to_string(k) + " is invalid or out of order");
+    }
+  }
+  const std::size_t number = findOrCreateCell(cell_index);
+  Cell& cell = cells_[number];
+  while (cell.capacity < blocks.size()) growCell(cell);
+  std::copy(blocks.begin(), blocks.end(), blocks_.begin() + cell.first);
+  cell.count = static_cast<std::uint16_t>(blocks.size());
+  block_count_ += blocks.size();
+}
+
 std::span<const Block> MLMap::blocksAt(std::size_t cell_number) const {
   const Cell& cell = cells_[cell_number];
   return {blocks_.data() + cell.first, cell.count};
@@ -241,11 +269,24 @@ MLMapStats MLMap::stats() const {
   MLMapStats stats;
   stats.cells = cells_.size();
   stats.blocks = block_count_;
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
   for (const Cell& cell : cells_) {
     for (const Block& block : blocksAt(static_cast<std::size_t>(&cell - cells_.data()))) {
       (block.isVertical() ? stats.vertical_blocks : stats.horizontal_blocks)++;
       if (block.plane != 0) ++stats.labelled_blocks;
+      low.z() = std::min<double>(low.z(), block.bottom());
+      high.z() = std::max<double>(high.z(), block.height);
     }
+    if (cell.count == 0) continue;
+    low.x() = std::min(low.x(), cell.index.j * cell_size_);
+    low.y() = std::min(low.y(), cell.index.i * cell_size_);
+    high.x() = std::max(high.x(), (cell.index.j + 1) * cell_size_);
+    high.y() = std::max(high.y(), (cell.index.i + 1) * cell_size_);
+  }
+  if (block_count_ > 0) {
+    stats.min = low;
+    stats.max = high;
   }
   stats.memory_bytes = cells_.capacity() * sizeof(Cell) + blocks_.capacity() * sizeof(Block) +
                        slots_.capacity() * sizeof(std::uint32_t) + sizeof(*this);

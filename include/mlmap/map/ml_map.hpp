@@ -19,6 +19,8 @@ struct MLMapStats {
   std::size_t vertical_blocks = 0;
   std::size_t labelled_blocks = 0;  // blocks with a plane label
   std::size_t memory_bytes = 0;     // heap bytes held by the block layer
+  Eigen::Vector3d min = Eigen::Vector3d::Zero();  // m, bounds of the cells and blocks
+  Eigen::Vector3d max = Eigen::Vector3d::Zero();
 };
 
 class MLMap {
@@ -36,6 +38,10 @@ class MLMap {
   // Adds a finished block, as a map reader or a merge does, by the same rules: a
   // horizontal block is fused like a measurement, a vertical one joins the blocks it reaches.
   void insertBlock(CellIndex cell, const Block& block);
+
+  // Restores a cell's blocks verbatim (map readers); the cell must be new and the
+  // blocks sorted, each at least cell_size above the one below.
+  void restoreCell(CellIndex cell, std::span<const Block> blocks);
 
   // The blocks of a cell, lowest first; empty when the cell has none.
   std::span<const Block> blocks(CellIndex cell) const;

@@ -1,0 +1,31 @@
+// .mlmap files: a versioned binary format holding a Map's parameters, its blocks and
+// its OcTree (OctoMap's own stream inside), closed by a CRC-32 of all that precedes.
+//
+//   magic      8 bytes  "\x89MLMAP\r\n" (binary-safe, like PNG's)
+//   version    u32      kMapFileVersion
+//   flags      u32      bit 0: an OcTree follows
+//   cell_size, octree_resolution, max_range   f64 each, metres
+//   cell_count u64, block_count u64
+//   per cell:  i i32, j i32, n u16, then n blocks: h f32, σ f32, d f32, π i32, kind u8
+//   octree     u64 byte count, then OcTree::write() output (.ot stream)
+//   crc32      u32 over every byte before it
+// All numbers little-endian.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+
+#include "mlmap/map/map.hpp"
+
+namespace mlmap::io {
+
+constexpr std::uint32_t kMapFileVersion = 1;
+
+// Written to a temporary file and renamed: a failure leaves any old file untouched.
+void writeMap(const std::filesystem::path& path, const Map& map);
+
+// Throws mlmap::Error naming the file and the byte offset for a damaged file, a file
+// of another version, or anything that is not an .mlmap file.
+Map readMap(const std::filesystem::path& path);
+
+}  // namespace mlmap::io

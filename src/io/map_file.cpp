@@ -1,0 +1,223 @@
+#include "mlmap/io/map_file.hpp"
+
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <octomap/AbstractOcTree.h>
+
+#include "crc32.hpp"
+#include "mlmap/error.hpp"
+#include "mlmap/io/atomic_file.hpp"
+
+namespace mlmap::io {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the .mlmap codec assumes little-endian");
+
+constexpr char kMagic[8] = {'\x89', 'M', 'L', 'M', 'A', 'P', '\r', '\n'};
+constexpr std::uint32_t kHasOctree = 1U;
+constexpr std::size_t kBlockBytes = 17;
+constexpr std::size_t kCellHeaderBytes = 10;
+
+template <typename T>
+void put(std::string& out, T value) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  out.append(bytes, sizeof(T));
+}
+
+// Reads the file's bytes in order; every read is bounds-checked and an error names
+// the file and the byte offset where it happened.
+class ByteReader {
+ public:
+  ByteReader(const std::string& bytes, std::size_t end, std::string name)
+      : bytes_(bytes), end_(end), name_(std::move(name)) {}
+
+  template <typename T>
+  T get(const char* what) {
+    need(sizeof(T), what);
+    T value;
+    std::memcpy(&value, bytes_.data() + offset_, sizeof(T));
+    offset_ += sizeof(T);
+    return value;
+  }
+  void need(std::size_t count, const char* what) const {
+    if (count > end_ - offset_) {
+      fail(std::string("file ends inside ") + what + " (needs " + std::to_string(count) +
+           " bytes, " + std::to_string(end_ - offset_) + " left)");
+    }
+  }
+  std::string_view take(std::size_t count, const char* what) {
+    need(count, what);
+    std::string_view view(bytes_.data() + offset_, count);
+    offset_ += count;
+    return view;
+  }
+  std::size_t offset() const { return offset_; }
+  std::size_t remaining() const { return end_ - offset_; }
+  [[noreturn]] void fail(const std::string& what) const { failAt(offset_, what); }
+  [[noreturn]] void failAt(std::size_t offset, const std::string& what) const {
+    throw Error(name_ + ": byte " + std::to_string(offset) + ": " + what);
+  }
+
+ private:
+  const std::string& bytes_;
+  std::size_t end_;
+  std::string name_;
+  std::size_t offset_ = 0;
+};
+
+std::string readWholeFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot open (no such file or no permission)");
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw Error(path.string() + ": read error");
+  return bytes;
+}
+
+}  // namespace
+
+void writeMap(const std::filesystem::path& path, const Map& map) {
+  const MLMap& blocks = map.blocks();
+  const MapConfig& config = map.config();
+  std::string out;
+  out.reserve(64 + blocks.cellCount() * kCellHeaderBytes + blocks.blockCount() * kBlockBytes);
+  out.append(kMagic, sizeof(kMagic));
+  put<std::uint32_t>(out, kMapFileVersion);
+  put<std::uint32_t>(out, map.hasOctree() ? kHasOctree : 0U);
+  put<double>(out, config.cell_size);
+  put<double>(out, config.octree_resolution);
+  put<double>(out, config.max_range);
+  std::uint64_t non_empty_cells = 0;
+  for (std::size_t n = 0; n < blocks.cellCount(); ++n) non_empty_cells += !blocks.blocksAt(n).empty();
+  put<std::uint64_t>(out, non_empty_cells);
+  put<std::uint64_t>(out, blocks.blockCount());
+  for (std::size_t n = 0; n < blocks.cellCount(); ++n) {
+    const auto cell_blocks = blocks.blocksAt(n);
+    if (cell_blocks.empty()) continue;
+    const CellIndex cell = blocks.cellAt(n);
+    put<std::int32_t>(out, cell.i);
+    put<std::int32_t>(out, cell.j);
+    put<std::uint16_t>(out, static_cast<std::uint16_t>(cell_blocks.size()));
+    for (const Block& block : cell_blocks) {
+      put<float>(out, block.height);
+      put<float>(out, block.variance);
+      put<float>(out, block.depth);
+      put<std::int32_t>(out, block.plane);
+      put<std::uint8_t>(out, static_cast<std::uint8_t>(block.kind));
+    }
+  }
+  std::string octree_bytes;
+  if (map.hasOctree()) {
+    std::ostringstream stream;
+    map.octree().write(stream);
+    octree_bytes = std::move(stream).str();
+  }
+  put<std::uint64_t>(out, octree_bytes.size());
+  out += octree_bytes;
+  put<std::uint32_t>(out, crc32(out.data(), out.size()));
+  writeAtomically(path, [&](std::ostream& stream) {
+    stream.write(out.data(), static_cast<std::streamsize>(out.size()));
+  });
+}
+
+Map readMap(const std::filesystem::path& path) {
+  const std::string bytes = readWholeFile(path);
+  const std::string name = path.string();
+  if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
+    throw Error(name + ": byte 0: not an .mlmap file (bad magic number)");
+  }
+  ByteReader header(bytes, bytes.size(), name);
+  header.take(sizeof(kMagic), "the magic number");
+  const auto version = header.get<std::uint32_t>("the version");
+  if (version != kMapFileVersion) {
+    header.failAt(8, "format version " + std::to_string(version) + ", this mlmap reads version " +
+                         std::to_string(kMapFileVersion) + " (rebuild the map with this mlmap)");
+  }
+  if (bytes.size() < header.offset() + sizeof(std::uint32_t)) {
+    header.fail("file too short for a checksum");
+  }
+  const std::size_t body_end = bytes.size() - sizeof(std::uint32_t);
+  std::uint32_t stored_crc;
+  std::memcpy(&stored_crc, bytes.data() + body_end, sizeof(stored_crc));
+  if (crc32(bytes.data(), body_end) != stored_crc) {
+    throw Error(name + ": checksum mismatch: the file is damaged or truncated");
+  }
+
+  ByteReader in(bytes, body_end, name);
+  in.take(sizeof(kMagic) + sizeof(std::uint32_t), "the header");
+  const auto flags = in.get<std::uint32_t>("the flags");
+  MapConfig config;
+  config.cell_size = in.get<double>("the cell size");
+  config.octree_resolution = in.get<double>("the OcTree resolution");
+  config.max_range = in.get<double>("the maximum range");
+  config.with_octree = (flags & kHasOctree) != 0;
+  if (!(config.cell_size > 0.0 && config.cell_size < 1e3) ||
+      (config.with_octree && !(config.octree_resolution > 0.0 && config.octree_resolution < 1e3))) {
+    in.failAt(16, "cell size or OcTree resolution out of range");
+  }
+  Map map(config);
+  const auto cell_count = in.get<std::uint64_t>("the cell count");
+  const auto block_count = in.get<std::uint64_t>("the block count");
+  // Refuse counts the file cannot hold before allocating anything for them.
+  if (cell_count > in.remaining() / kCellHeaderBytes ||
+      block_count > in.remaining() / kBlockBytes) {
+    in.fail("the header claims " + std::to_string(cell_count) + " cells and " +
+            std::to_string(block_count) + " blocks, more than the file holds");
+  }
+  std::vector<Block> cell_blocks;
+  std::uint64_t blocks_seen = 0;
+  for (std::uint64_t c = 0; c < cell_count; ++c) {
+    const std::size_t cell_offset = in.offset();
+    const CellIndex cell{in.get<std::int32_t>("a cell index"), in.get<std::int32_t>("a cell index")};
+    const auto count = in.get<std::uint16_t>("a block count");
+    in.need(std::size_t{count} * kBlockBytes, "a cell's blocks");
+    cell_blocks.resize(count);
+    for (Block& block : cell_blocks) {
+      block.height = in.get<float>("a block");
+      block.variance = in.get<float>("a block");
+      block.depth = in.get<float>("a block");
+      block.plane = in.get<std::int32_t>("a block");
+      const auto kind = in.get<std::uint8_t>("a block");
+      if (kind > 1) in.failAt(in.offset() - 1, "unknown block kind " + std::to_string(kind));
+      block.kind = static_cast<BlockKind>(kind);
+    }
+    blocks_seen += count;
+    try {
+      map.blocks().restoreCell(cell, cell_blocks);
+    } catch (const Error& error) {
+      in.failAt(cell_offset, error.what());
+    }
+  }
+  if (blocks_seen != block_count) {
+    in.fail("the header claims " + std::to_string(block_count) + " blocks, the cells hold " +
+            std::to_string(blocks_seen));
+  }
+  const auto octree_size = in.get<std::uint64_t>("the OcTree size");
+  if (octree_size != in.remaining()) {
+    in.fail("the OcTree claims " + std::to_string(octree_size) + " bytes, " +
+            std::to_string(in.remaining()) + " remain");
+  }
+  if (config.with_octree) {
+    const std::size_t octree_offset = in.offset();
+    std::istringstream stream(std::string(in.take(octree_size, "the OcTree")));
+    std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(stream));
+    auto* octree = dynamic_cast<octomap::OcTree*>(tree.get());
+    if (octree == nullptr) in.failAt(octree_offset, "the embedded OcTree cannot be read");
+    tree.release();
+    try {
+      map.setOctree(std::unique_ptr<octomap::OcTree>(octree));
+    } catch (const Error& error) {
+      in.failAt(octree_offset, error.what());
+    }
+  } else if (octree_size != 0) {
+    in.fail("an OcTree follows but the flags say none");
+  }
+  return map;
+}
+
+}  // namespace mlmap::io

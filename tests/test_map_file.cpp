@@ -1,0 +1,135 @@
+// .mlmap files: write, read back, compare; and every kind of damage is refused.
+#include <doctest/doctest.h>
+
+#include <cstring>
+#include <random>
+
+#include "../src/io/crc32.hpp"
+#include "helpers.hpp"
+#include "mlmap/error.hpp"
+#include "mlmap/io/map_file.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+Map smallRoomMap(bool with_octree) {
+  MapConfig config;
+  config.cell_size = 0.1;
+  config.with_octree = with_octree;
+  Map map(config);
+  Scan scan;
+  scan.pose.translation() = Eigen::Vector3d(1.0, 1.0, 0.5);
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> coordinate(-0.9, 0.9);
+  for (int k = 0; k < 3000; ++k) {
+    scan.points.emplace_back(coordinate(random), coordinate(random), -0.5);   // floor
+    scan.points.emplace_back(coordinate(random), coordinate(random), 1.5);    // ceiling
+    scan.points.emplace_back(0.95, coordinate(random), coordinate(random) + 0.5);  // wall
+  }
+  map.insertScan(scan);
+  map.compact();
+  map.blocks().mutableBlocksAt(0)[0].plane = 7;
+  return map;
+}
+
+void checkSameBlocks(const MLMap& a, const MLMap& b) {
+  REQUIRE(a.blockCount() == b.blockCount());
+  REQUIRE(a.cellCount() == b.cellCount());
+  for (std::size_t n = 0; n < a.cellCount(); ++n) {
+    const auto expected = a.blocksAt(n);
+    const auto actual = b.blocks(a.cellAt(n));
+    REQUIRE(actual.size() == expected.size());
+    for (std::size_t k = 0; k < expected.size(); ++k) {
+      CHECK(actual[k].height == expected[k].height);
+      CHECK(actual[k].variance == expected[k].variance);
+      CHECK(actual[k].depth == expected[k].depth);
+      CHECK(actual[k].plane == expected[k].plane);
+      CHECK(actual[k].kind == expected[k].kind);
+    }
+  }
+}
+
+}  // namespace
+
+TEST_CASE("MapFile: a map with its OcTree round-trips exactly") {
+  test::TempDir dir;
+  const Map map = smallRoomMap(true);
+  io::writeMap(dir / "room.mlmap", map);
+  const Map read = io::readMap(dir / "room.mlmap");
+  CHECK(read.config().cell_size == map.config().cell_size);
+  checkSameBlocks(map.blocks(), read.blocks());
+  REQUIRE(read.hasOctree());
+  CHECK(read.octree().size() == map.octree().size());
+  CHECK(read.octree().getResolution() == map.octree().getResolution());
+  // The same voxels with the same log-odds.
+  std::size_t compared = 0;
+  for (auto it = map.octree().begin_leafs(); it != map.octree().end_leafs(); ++it, ++compared) {
+    const auto* node = read.octree().search(it.getKey(), static_cast<unsigned>(it.getDepth()));
+    REQUIRE(node != nullptr);
+    CHECK(node->getLogOdds() == it->getLogOdds());
+  }
+  CHECK(compared > 100);
+  // Only the map is left in the directory: no temporary file.
+  CHECK(std::distance(std::filesystem::directory_iterator(dir.path()),
+                      std::filesystem::directory_iterator()) == 1);
+}
+
+TEST_CASE("MapFile: a block-only map round-trips") {
+  test::TempDir dir;
+  const Map map = smallRoomMap(false);
+  io::writeMap(dir / "blocks.mlmap", map);
+  const Map read = io::readMap(dir / "blocks.mlmap");
+  CHECK_FALSE(read.hasOctree());
+  checkSameBlocks(map.blocks(), read.blocks());
+}
+
+TEST_CASE("MapFile: damaged, truncated, foreign and future files are refused by name") {
+  test::TempDir dir;
+  io::writeMap(dir / "good.mlmap", smallRoomMap(true));
+  const std::string good = test::readText(dir / "good.mlmap");
+
+  SUBCASE("missing") {
+    CHECK_THROWS_WITH_AS(io::readMap(dir / "none.mlmap"), doctest::Contains("none.mlmap"), Error);
+  }
+  SUBCASE("not a map") {
+    test::writeText(dir / "text.mlmap", "x y z\n1 2 3\n");
+    CHECK_THROWS_WITH_AS(io::readMap(dir / "text.mlmap"), doctest::Contains("bad magic"), Error);
+  }
+  SUBCASE("a flipped byte") {
+    std::string damaged = good;
+    damaged[damaged.size() / 2] ^= 0x10;
+    test::writeText(dir / "flip.mlmap", damaged);
+    CHECK_THROWS_WITH_AS(io::readMap(dir / "flip.mlmap"), doctest::Contains("checksum"), Error);
+  }
+  SUBCASE("truncated") {
+    test::writeText(dir / "cut.mlmap", good.substr(0, good.size() / 3));
+    CHECK_THROWS_WITH_AS(io::readMap(dir / "cut.mlmap"), doctest::Contains("cut.mlmap"), Error);
+    test::writeText(dir / "tiny.mlmap", good.substr(0, 10));
+    CHECK_THROWS_AS(io::readMap(dir / "tiny.mlmap"), Error);
+  }
+  SUBCASE("another version") {
+    std::string future = good;
+    future[8] = 2;
+    test::writeText(dir / "future.mlmap", future);
+    CHECK_THROWS_WITH_AS(io::readMap(dir / "future.mlmap"), doctest::Contains("version 2"), Error);
+  }
+  SUBCASE("a hostile cell count with a valid checksum") {
+    std::string hostile = good.substr(0, good.size() - 4);
+    const std::uint64_t huge = 1ULL << 60;
+    std::memcpy(hostile.data() + 40, &huge, sizeof(huge));
+    const std::uint32_t crc = io::crc32(hostile.data(), hostile.size());
+    hostile.append(reinterpret_cast<const char*>(&crc), sizeof(crc));
+    test::writeText(dir / "hostile.mlmap", hostile);
+    CHECK_THROWS_WITH_AS(io::readMap(dir / "hostile.mlmap"), doctest::Contains("more than the file"),
+                         Error);
+  }
+}
+
+TEST_CASE("MapFile: a failed write leaves the old file untouched") {
+  test::TempDir dir;
+  io::writeMap(dir / "map.mlmap", smallRoomMap(false));
+  const std::string before = test::readText(dir / "map.mlmap");
+  CHECK_THROWS_AS(io::writeMap(dir / "no-such-dir" / "map.mlmap", smallRoomMap(false)), Error);
+  CHECK(test::readText(dir / "map.mlmap") == before);
+}
