@@ -1,10 +1,97 @@
+// mlmap build: scans + poses -> an .mlmap file (both layers).
+#include <chrono>
+#include <cstdio>
+
 #include "commands.hpp"
+#include "mlmap/error.hpp"
+#include "mlmap/io/map_file.hpp"
+#include "mlmap/io/scan_file.hpp"
+#include "mlmap/io/tum_poses.hpp"
+#include "mlmap/map/map.hpp"
+#include "progress.hpp"
 
 namespace mlmap::cli {
+namespace {
+
+struct BuildOptions {
+  std::string output;
+  std::string poses;
+  std::vector<std::string> scans;
+  MapConfig map;
+  bool no_octree = false;
+};
+
+int runBuild(const BuildOptions& options, bool quiet) {
+  std::vector<io::StampedPose> poses;
+  if (!options.poses.empty()) poses = io::readTumPoses(options.poses);
+
+  // Scans are read one file at a time so memory holds the map, not every scan.
+  MapConfig config = options.map;
+  config.with_octree = !options.no_octree;
+  Map map(config);
+  const auto start = std::chrono::steady_clock::now();
+  Progress progress("build", options.scans.size(), !quiet);
+  std::size_t scan_count = 0;
+  std::size_t point_count = 0;
+  for (std::size_t file = 0; file < options.scans.size(); ++file) {
+    for (Scan& scan : io::readScans(options.scans[file])) {
+      if (!poses.empty()) {
+        if (scan_count >= poses.size()) {
+          throw Error(options.poses + ": " + std::to_string(poses.size()) +
+                      " poses, but there are more scans (" + options.scans[file] + " is scan " +
+                      std::to_string(scan_count + 1) + ")");
+        }
+        scan.pose = poses[scan_count].pose;
+      }
+      map.insertScan(scan);
+      ++scan_count;
+      point_count += scan.size();
+    }
+    progress.update(file + 1, std::to_string(point_count) + " points");
+  }
+  if (!poses.empty() && scan_count != poses.size()) {
+    throw Error(options.poses + ": " + std::to_string(poses.size()) + " poses for " +
+                std::to_string(scan_count) + " scans");
+  }
+  map.compact();
+  progress.finish(std::to_string(point_count) + " points");
+  io::writeMap(options.output, map);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const MLMapStats stats = map.blocks().stats();
+  std::printf("%s: %zu scans, %zu points -> %zu cells, %zu blocks (%zu horizontal, %zu vertical)"
+              " at %.3g m cells in %.2f s\n",
+              options.output.c_str(), scan_count, point_count, stats.cells, stats.blocks,
+              stats.horizontal_blocks, stats.vertical_blocks, config.cell_size, seconds);
+  return 0;
+}
+
+}  // namespace
 
 void addBuildCommand(CLI::App& app, Context& context) {
-  auto* command = app.add_subcommand("build", "TODO");
-  command->callback([&context] { context.run = [] { return 0; }; });
+  auto options = std::make_shared<BuildOptions>();
+  auto* command = app.add_subcommand(
+      "build", "Build an ML map (blocks + OcTree) from scans and their poses");
+  command->add_option("-o,--output", options->output, "Map file to write (.mlmap)")->required();
+  command->add_option("--poses", options->poses,
+                      "TUM pose file, one pose per scan in order (scan i in the sensor frame, pose i "
+                      "maps it to the world); without it each scan's own pose is used");
+  command->add_option("--cell-size", options->map.cell_size, "ML-map cell size, m")
+      ->default_val(0.1)
+      ->check(CLI::PositiveNumber);
+  command->add_option("--octree-resolution", options->map.octree_resolution,
+                      "OcTree voxel size, m (default: the cell size)")
+      ->check(CLI::NonNegativeNumber);
+  command->add_option("--max-range", options->map.max_range,
+                      "Cut OcTree rays at this range, m (default: no limit)");
+  command->add_flag("--no-octree", options->no_octree, "Build the block layer only");
+  command->add_option("scans", options->scans,
+                      "Scan files: .xyz .txt .pts .ply .pcd .3d (3DTK) .graph (OctoMap)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->callback([options, &context] {
+    context.run = [options, &context] { return runBuild(*options, context.quiet); };
+  });
 }
 
 }  // namespace mlmap::cli

@@ -1,10 +1,86 @@
+// mlmap info: what a map file holds.
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
 #include "commands.hpp"
+#include "mlmap/io/map_file.hpp"
 
 namespace mlmap::cli {
+namespace {
+
+int runInfo(const std::string& path, bool as_json) {
+  const Map map = io::readMap(path);
+  const MLMapStats stats = map.blocks().stats();
+  nlohmann::json info;
+  info["file"] = path;
+  info["file_bytes"] = std::filesystem::file_size(path);
+  info["cell_size"] = map.config().cell_size;
+  info["cells"] = stats.cells;
+  info["blocks"] = {{"total", stats.blocks},
+                    {"horizontal", stats.horizontal_blocks},
+                    {"vertical", stats.vertical_blocks},
+                    {"labelled", stats.labelled_blocks}};
+  info["bounds"] = {{"min", {stats.min.x(), stats.min.y(), stats.min.z()}},
+                    {"max", {stats.max.x(), stats.max.y(), stats.max.z()}}};
+  info["memory_bytes"] = {{"blocks", stats.memory_bytes}};
+  const double bytes_per_block =
+      stats.blocks == 0 ? 0.0 : static_cast<double>(stats.memory_bytes) / static_cast<double>(stats.blocks);
+  if (map.hasOctree()) {
+    const auto& tree = map.octree();
+    std::size_t occupied = 0;
+    std::size_t leaves = 0;
+    for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
+      ++leaves;
+      occupied += tree.isNodeOccupied(*it) ? 1 : 0;
+    }
+    info["octree"] = {{"resolution", tree.getResolution()},
+                      {"nodes", tree.size()},
+                      {"leaves", leaves},
+                      {"occupied_leaves", occupied},
+                      {"free_leaves", leaves - occupied}};
+    info["memory_bytes"]["octree"] = tree.memoryUsage();
+  }
+  if (as_json) {
+    std::cout << info.dump(2) << "\n";
+    return 0;
+  }
+  std::printf("%s (%.1f MB)\n", path.c_str(), static_cast<double>(info["file_bytes"]) / 1e6);
+  std::printf("  cell size      %.3g m\n", map.config().cell_size);
+  std::printf("  cells          %zu\n", stats.cells);
+  std::printf("  blocks         %zu (%zu horizontal, %zu vertical, %zu labelled)\n", stats.blocks,
+              stats.horizontal_blocks, stats.vertical_blocks, stats.labelled_blocks);
+  std::printf("  bounds         x %.2f..%.2f  y %.2f..%.2f  z %.2f..%.2f m\n", stats.min.x(),
+              stats.max.x(), stats.min.y(), stats.max.y(), stats.min.z(), stats.max.z());
+  std::printf("  block memory   %.1f MB (%.1f bytes/block)\n", static_cast<double>(stats.memory_bytes) / 1e6,
+              bytes_per_block);
+  if (map.hasOctree()) {
+    const auto& octree = info["octree"];
+    std::printf("  OcTree         %.3g m, %zu nodes, %zu leaves (%zu occupied, %zu free), %.1f MB\n",
+                static_cast<double>(octree["resolution"]), static_cast<std::size_t>(octree["nodes"]),
+                static_cast<std::size_t>(octree["leaves"]),
+                static_cast<std::size_t>(octree["occupied_leaves"]),
+                static_cast<std::size_t>(octree["free_leaves"]),
+                static_cast<double>(info["memory_bytes"]["octree"]) / 1e6);
+  } else {
+    std::printf("  OcTree         none (built with --no-octree)\n");
+  }
+  return 0;
+}
+
+}  // namespace
 
 void addInfoCommand(CLI::App& app, Context& context) {
-  auto* command = app.add_subcommand("info", "TODO");
-  command->callback([&context] { context.run = [] { return 0; }; });
+  auto path = std::make_shared<std::string>();
+  auto as_json = std::make_shared<bool>(false);
+  auto* command = app.add_subcommand("info", "Print what a map file holds");
+  command->add_option("map", *path, "Map file (.mlmap)")->required()->check(CLI::ExistingFile);
+  command->add_flag("--json", *as_json, "Print JSON instead of text");
+  command->callback([path, as_json, &context] {
+    context.run = [path, as_json] { return runInfo(*path, *as_json); };
+  });
 }
 
 }  // namespace mlmap::cli
