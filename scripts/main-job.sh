@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# The main job on the scenes that ship in maps/: install, build, simulate the lab,
+# build its ML map from the scans and poses, and print what the map holds.
+# Usage: scripts/main-job.sh [SCENE.json] [OUT_DIR]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scene=${1:-maps/lab.json}
+out=${2:-out/$(basename "$scene" .json)}
+bash scripts/install-deps.sh
+bash scripts/build.sh
+mlmap=build/mlmap
+"$mlmap" simulate "$scene" -o "$out"
+"$mlmap" build -o "$out/map.mlmap" --poses "$out/poses_true.txt" --cell-size 0.05 "$out"/scan_*.xyz
+"$mlmap" info "$out/map.mlmap"
