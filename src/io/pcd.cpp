@@ -1,0 +1,598 @@
+// PCD reader and writer (PCL's format, v0.7 and the older headers PCL still
+// reads). The whole file is read into memory once; the header is parsed line by
+// line (errors name the line), binary bodies are decoded with explicit bounds
+// checks and memcpy (points are packed, so unaligned), errors in them name the
+// byte offset. Every size a header claims is checked against the bytes actually
+// present before anything is allocated for it.
+#include "mlmap/io/pcd.hpp"
+
+#include <lzf.h>
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <istream>
+#include <limits>
+#include <optional>
+#include <streambuf>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mlmap/error.hpp"
+#include "mlmap/io/atomic_file.hpp"
+#include "text_lines.hpp"
+
+namespace mlmap::io {
+namespace {
+
+// ---------------------------------------------------------------- file buffer
+
+std::string readWholeFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot open file");
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw Error(path.string() + ": cannot determine file size");
+  in.seekg(0, std::ios::beg);
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  if (!in.read(bytes.data(), size)) throw Error(path.string() + ": read failed");
+  return bytes;
+}
+
+// An istream over a buffer without copying it; tellg() gives the offset of the
+// binary body once the header lines have been consumed.
+class MemoryBuffer : public std::streambuf {
+ public:
+  explicit MemoryBuffer(std::string& bytes) {
+    setg(bytes.data(), bytes.data(), bytes.data() + bytes.size());
+  }
+
+ protected:
+  pos_type seekoff(off_type offset, std::ios_base::seekdir direction,
+                   std::ios_base::openmode /*which*/) override {
+    if (offset != 0 || direction != std::ios_base::cur) return pos_type(off_type(-1));
+    return pos_type(gptr() - eback());
+  }
+};
+
+// PCD binary data is little-endian in practice (PCL writes host order on x86/ARM).
+template <typename T>
+T loadLittleEndian(const char* source) {
+  T value;
+  if constexpr (std::endian::native == std::endian::little) {
+    std::memcpy(&value, source, sizeof(T));
+  } else {
+    unsigned char reversed[sizeof(T)];
+    for (std::size_t i = 0; i < sizeof(T); ++i) reversed[i] = source[sizeof(T) - 1 - i];
+    std::memcpy(&value, reversed, sizeof(T));
+  }
+  return value;
+}
+
+template <typename T>
+void storeLittleEndian(char* target, T value) {
+  std::memcpy(target, &value, sizeof(T));
+  if constexpr (std::endian::native != std::endian::little) {
+    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(target[i], target[sizeof(T) - 1 - i]);
+  }
+}
+
+// ---------------------------------------------------------------- header model
+
+struct Field {
+  std::string name;
+  std::size_t size = 4;    // bytes per value: 1, 2, 4 or 8
+  char type = 'F';         // F float, I signed, U unsigned
+  std::size_t count = 1;   // values per point
+  std::size_t offset = 0;  // bytes before this field in a packed point
+};
+
+enum class Encoding { Ascii, Binary, BinaryCompressed };
+
+struct Header {
+  std::vector<Field> fields;
+  std::uint64_t points = 0;
+  std::size_t point_bytes = 0;
+  Pose viewpoint = Pose::Identity();
+  Encoding encoding = Encoding::Ascii;
+  std::size_t x = 0, y = 0, z = 0;  // field indices
+  std::optional<std::size_t> label;
+};
+
+[[noreturn]] void failAt(const std::string& source, std::size_t line, const std::string& what) {
+  throw Error(source + ":" + std::to_string(line) + ": " + what);
+}
+
+std::uint64_t parseCount(const TextLines& lines, std::string_view field) {
+  const std::int64_t value = lines.parseInt(field);
+  if (value < 0) lines.fail("negative value " + std::string(field));
+  return static_cast<std::uint64_t>(value);
+}
+
+// Reads header lines up to and including DATA, validates them together.
+Header parseHeader(TextLines& lines) {
+  std::vector<std::string> names, types;
+  std::vector<std::size_t> sizes, counts;
+  std::optional<std::uint64_t> width, height, points;
+  std::size_t fields_line = 0, sizes_line = 0, types_line = 0, counts_line = 0;
+  std::size_t width_line = 0, points_line = 0;
+  Header header;
+  const auto once = [&](std::size_t& line_of_key, std::string_view key) {
+    if (line_of_key != 0) lines.fail("duplicate " + std::string(key) + " line");
+    line_of_key = lines.lineNumber();
+  };
+  std::size_t version_line = 0, height_line = 0, viewpoint_line = 0;
+
+  while (true) {
+    if (!lines.next()) lines.fail("file ends inside the PCD header (no DATA line)");
+    const auto tokens = lines.fields(/*hash_comments=*/true);
+    if (tokens.empty()) continue;
+    const std::string_view key = tokens[0];
+    const std::size_t values = tokens.size() - 1;
+    if (key == "VERSION") {
+      once(version_line, key);
+      static const std::vector<std::string_view> known = {"0.7", ".7", "v0.7", "v.7", "0.6",
+                                                          ".6",  "v.6", "0.5", ".5",  "v.5"};
+      if (values != 1 || std::find(known.begin(), known.end(), tokens[1]) == known.end()) {
+        lines.fail("unsupported PCD version (expected VERSION 0.7)");
+      }
+    } else if (key == "FIELDS" || key == "COLUMNS") {
+      once(fields_line, key);
+      if (values == 0) lines.fail("FIELDS names no field");
+      for (std::size_t i = 1; i < tokens.size(); ++i) names.emplace_back(tokens[i]);
+    } else if (key == "SIZE") {
+      once(sizes_line, key);
+      for (std::size_t i = 1; i < tokens.size(); ++i) {
+        const std::uint64_t size = parseCount(lines, tokens[i]);
+        if (size != 1 && size != 2 && size != 4 && size != 8) {
+          lines.fail("SIZE must be 1, 2, 4 or 8, found " + std::string(tokens[i]));
+        }
+        sizes.push_back(size);
+      }
+    } else if (key == "TYPE") {
+      once(types_line, key);
+      for (std::size_t i = 1; i < tokens.size(); ++i) {
+        if (tokens[i] != "F" && tokens[i] != "I" && tokens[i] != "U") {
+          lines.fail("TYPE must be F, I or U, found '" + std::string(tokens[i]) + "'");
+        }
+        types.emplace_back(tokens[i]);
+      }
+    } else if (key == "COUNT") {
+      once(counts_line, key);
+      for (std::size_t i = 1; i < tokens.size(); ++i) {
+        const std::uint64_t count = parseCount(lines, tokens[i]);
+        // A point of more than a million values is not a point cloud.
+        if (count == 0 || count > 1'000'000) lines.fail("COUNT out of range: " + std::string(tokens[i]));
+        counts.push_back(count);
+      }
+    } else if (key == "WIDTH") {
+      once(width_line, key);
+      if (values != 1) lines.fail("expected 'WIDTH <n>'");
+      width = parseCount(lines, tokens[1]);
+    } else if (key == "HEIGHT") {
+      once(height_line, key);
+      if (values != 1) lines.fail("expected 'HEIGHT <n>'");
+      height = parseCount(lines, tokens[1]);
+    } else if (key == "VIEWPOINT") {
+      once(viewpoint_line, key);
+      if (values != 7) lines.fail("expected 'VIEWPOINT tx ty tz qw qx qy qz'");
+      double v[7];
+      for (int i = 0; i < 7; ++i) v[i] = lines.parseDouble(tokens[i + 1]);
+      Eigen::Quaterniond rotation(v[3], v[4], v[5], v[6]);
+      if (rotation.norm() < 1e-9) lines.fail("VIEWPOINT quaternion is zero");
+      header.viewpoint = Pose::Identity();
+      header.viewpoint.translate(Eigen::Vector3d(v[0], v[1], v[2]));
+      header.viewpoint.rotate(rotation.normalized());
+    } else if (key == "POINTS") {
+      once(points_line, key);
+      if (values != 1) lines.fail("expected 'POINTS <n>'");
+      points = parseCount(lines, tokens[1]);
+    } else if (key == "DATA") {
+      if (values != 1) lines.fail("expected 'DATA ascii|binary|binary_compressed'");
+      if (tokens[1] == "ascii") {
+        header.encoding = Encoding::Ascii;
+      } else if (tokens[1] == "binary") {
+        header.encoding = Encoding::Binary;
+      } else if (tokens[1] == "binary_compressed") {
+        header.encoding = Encoding::BinaryCompressed;
+      } else {
+        lines.fail("unknown DATA encoding '" + std::string(tokens[1]) + "'");
+      }
+      break;
+    } else {
+      lines.fail("not a PCD header line: unknown keyword '" + std::string(key.substr(0, 40)) + "'");
+    }
+  }
+
+  const std::string& source = lines.sourceName();
+  if (fields_line == 0) lines.fail("PCD header has no FIELDS line");
+  if (sizes_line == 0) lines.fail("PCD header has no SIZE line");
+  if (types_line == 0) lines.fail("PCD header has no TYPE line");
+  if (width_line == 0) lines.fail("PCD header has no WIDTH line");
+  const auto same_length = [&](std::size_t length, std::size_t line, std::string_view key) {
+    if (length != names.size()) {
+      failAt(source, line, std::string(key) + " has " + std::to_string(length) +
+                               " entries but FIELDS has " + std::to_string(names.size()));
+    }
+  };
+  same_length(sizes.size(), sizes_line, "SIZE");
+  same_length(types.size(), types_line, "TYPE");
+  if (counts_line != 0) same_length(counts.size(), counts_line, "COUNT");
+  if (counts_line == 0) counts.assign(names.size(), 1);
+
+  // HEIGHT defaults to 1 and POINTS to WIDTH*HEIGHT, as in PCL's older headers.
+  const std::uint64_t rows = height.value_or(1);
+  if (rows != 0 && *width > std::numeric_limits<std::uint64_t>::max() / rows) {
+    failAt(source, width_line, "WIDTH * HEIGHT overflows");
+  }
+  const std::uint64_t organized_points = *width * rows;
+  if (points && *points != organized_points) {
+    failAt(source, points_line, "POINTS " + std::to_string(*points) + " is not WIDTH * HEIGHT = " +
+                                    std::to_string(organized_points));
+  }
+  header.points = organized_points;
+
+  std::optional<std::size_t> x, y, z;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    Field field{names[i], sizes[i], types[i][0], counts[i], header.point_bytes};
+    if (field.type == 'F' && field.size != 4 && field.size != 8) {
+      failAt(source, sizes_line, "float field '" + field.name + "' must have SIZE 4 or 8");
+    }
+    header.point_bytes += field.size * field.count;
+    std::optional<std::size_t>* coordinate = field.name == "x"   ? &x
+                                             : field.name == "y" ? &y
+                                             : field.name == "z" ? &z
+                                                                 : nullptr;
+    if (coordinate != nullptr && !*coordinate) {
+      if (field.type != 'F' || field.count != 1) {
+        failAt(source, types_line, "field '" + field.name + "' must be a float (F 4 or F 8) with COUNT 1");
+      }
+      *coordinate = i;
+    }
+    // Float or multi-valued labels are not ours to interpret: ignored.
+    if (field.name == "label" && field.type != 'F' && field.count == 1 && !header.label) {
+      header.label = i;
+    }
+    header.fields.push_back(std::move(field));
+  }
+  if (!x || !y || !z) failAt(source, fields_line, "PCD file has no x, y and z fields");
+  header.x = *x;
+  header.y = *y;
+  header.z = *z;
+  return header;
+}
+
+// ---------------------------------------------------------------- decoding
+
+double loadCoordinate(const Field& field, const char* source) {
+  return field.size == 4 ? static_cast<double>(loadLittleEndian<float>(source))
+                         : loadLittleEndian<double>(source);
+}
+
+std::int64_t loadInteger(const Field& field, const char* source) {
+  const bool is_signed = field.type == 'I';
+  switch (field.size) {
+    case 1:
+      return is_signed ? std::int64_t{static_cast<std::int8_t>(*source)}
+                       : std::int64_t{static_cast<std::uint8_t>(*source)};
+    case 2:
+      return is_signed ? std::int64_t{loadLittleEndian<std::int16_t>(source)}
+                       : std::int64_t{loadLittleEndian<std::uint16_t>(source)};
+    case 4:
+      return is_signed ? std::int64_t{loadLittleEndian<std::int32_t>(source)}
+                       : std::int64_t{loadLittleEndian<std::uint32_t>(source)};
+    default: {
+      if (is_signed) return loadLittleEndian<std::int64_t>(source);
+      const auto value = loadLittleEndian<std::uint64_t>(source);
+      // Saturates; checkedLabel rejects anything that large anyway.
+      return value > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())
+                 ? std::numeric_limits<std::int64_t>::max()
+                 : static_cast<std::int64_t>(value);
+    }
+  }
+}
+
+// `where` builds the location only when the label is out of range.
+template <typename Where>
+std::int32_t checkedLabel(std::int64_t value, const Where& where) {
+  if (value < std::numeric_limits<std::int32_t>::min() ||
+      value > std::numeric_limits<std::int32_t>::max()) {
+    throw Error(where() + ": label " + std::to_string(value) + " does not fit a 32-bit integer");
+  }
+  return static_cast<std::int32_t>(value);
+}
+
+std::string byteWhere(const std::string& source, std::size_t byte) {
+  return source + ": byte " + std::to_string(byte);
+}
+
+// Where the x, y, z and label values of point i sit: `base[k] + i * stride[k]`.
+// Packed rows (binary) and field-by-field blocks (binary_compressed) differ only here.
+struct Layout {
+  const char* base[4];       // x, y, z, label
+  std::size_t stride[4];
+};
+
+// `where` names the location of a bad value for the error message.
+template <typename Where>
+void decodePoints(const Header& header, const Layout& layout, const Where& where, Scan& scan) {
+  const Field& fx = header.fields[header.x];
+  const Field& fy = header.fields[header.y];
+  const Field& fz = header.fields[header.z];
+  const auto count = static_cast<std::size_t>(header.points);
+  scan.points.reserve(count);
+  if (header.label) scan.labels.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const Point point(loadCoordinate(fx, layout.base[0] + i * layout.stride[0]),
+                      loadCoordinate(fy, layout.base[1] + i * layout.stride[1]),
+                      loadCoordinate(fz, layout.base[2] + i * layout.stride[2]));
+    if (!point.allFinite()) continue;  // organized clouds mark "no return" with NaN
+    scan.points.push_back(point);
+    if (header.label) {
+      const char* label = layout.base[3] + i * layout.stride[3];
+      scan.labels.push_back(checkedLabel(loadInteger(header.fields[*header.label], label),
+                                          [&] { return where(label); }));
+    }
+  }
+}
+
+void readBinary(const Header& header, const std::string& bytes, std::size_t start,
+                const std::string& source, Scan& scan) {
+  const std::size_t remaining = bytes.size() - start;
+  if (header.points > remaining / header.point_bytes) {
+    throw Error(byteWhere(source, bytes.size()) + ": data ends inside point " +
+                std::to_string(remaining / header.point_bytes) + " (" +
+                std::to_string(header.points) + " points of " + std::to_string(header.point_bytes) +
+                " bytes expected from byte " + std::to_string(start) + ")");
+  }
+  const char* body = bytes.data() + start;
+  Layout layout{};
+  const std::size_t indices[4] = {header.x, header.y, header.z, header.label.value_or(header.x)};
+  for (int k = 0; k < 4; ++k) {
+    layout.base[k] = body + header.fields[indices[k]].offset;
+    layout.stride[k] = header.point_bytes;
+  }
+  decodePoints(header, layout,
+               [&](const char* at) { return byteWhere(source, static_cast<std::size_t>(at - bytes.data())); },
+               scan);
+}
+
+// LZF output is at most 88 times its input (a 3-byte back reference expands to
+// 264 bytes), so a declared size beyond that is a lie we need not allocate for.
+constexpr std::uint64_t kMaxLzfExpansion = 88;
+
+void readBinaryCompressed(const Header& header, const std::string& bytes, std::size_t start,
+                          const std::string& source, Scan& scan) {
+  if (bytes.size() - start < 8) {
+    throw Error(byteWhere(source, bytes.size()) +
+                ": data ends before the compressed and uncompressed sizes (expected " +
+                std::to_string(header.points) + " points)");
+  }
+  const auto compressed_bytes = loadLittleEndian<std::uint32_t>(bytes.data() + start);
+  const auto uncompressed_bytes = loadLittleEndian<std::uint32_t>(bytes.data() + start + 4);
+  const std::uint64_t expected_bytes =
+      header.points > std::numeric_limits<std::uint32_t>::max() / header.point_bytes
+          ? std::numeric_limits<std::uint64_t>::max()
+          : header.points * header.point_bytes;
+  if (uncompressed_bytes != expected_bytes) {
+    throw Error(byteWhere(source, start + 4) + ": declared uncompressed size " +
+                std::to_string(uncompressed_bytes) + " is not " + std::to_string(header.points) +
+                " points * " + std::to_string(header.point_bytes) + " bytes");
+  }
+  const std::size_t data_start = start + 8;
+  if (compressed_bytes > bytes.size() - data_start) {
+    throw Error(byteWhere(source, bytes.size()) + ": compressed data ends after " +
+                std::to_string(bytes.size() - data_start) + " of " +
+                std::to_string(compressed_bytes) + " bytes (from byte " +
+                std::to_string(data_start) + ", " + std::to_string(header.points) +
+                " points expected)");
+  }
+  if (uncompressed_bytes == 0) return;
+  if (uncompressed_bytes / kMaxLzfExpansion > compressed_bytes) {
+    throw Error(byteWhere(source, start) + ": " + std::to_string(compressed_bytes) +
+                " compressed bytes cannot hold " + std::to_string(uncompressed_bytes) + " bytes");
+  }
+  std::string unpacked(uncompressed_bytes, '\0');
+  const unsigned int produced = lzf_decompress(bytes.data() + data_start, compressed_bytes,
+                                               unpacked.data(), uncompressed_bytes);
+  if (produced != uncompressed_bytes) {
+    throw Error(byteWhere(source, data_start) + ": LZF data does not decompress to the declared " +
+                std::to_string(uncompressed_bytes) + " bytes");
+  }
+  // Field by field: all values of field 0, then all of field 1, ...
+  Layout layout{};
+  const std::size_t indices[4] = {header.x, header.y, header.z, header.label.value_or(header.x)};
+  for (int k = 0; k < 4; ++k) {
+    const Field& field = header.fields[indices[k]];
+    layout.base[k] = unpacked.data() + header.points * field.offset;
+    layout.stride[k] = field.size;
+  }
+  decodePoints(header, layout,
+               [&](const char* at) {
+                 return source + ": decompressed byte " + std::to_string(at - unpacked.data());
+               },
+               scan);
+}
+
+bool isNanToken(std::string_view token) {
+  if (!token.empty() && (token.front() == '-' || token.front() == '+')) token.remove_prefix(1);
+  return token.size() == 3 && (token[0] | 0x20) == 'n' && (token[1] | 0x20) == 'a' &&
+         (token[2] | 0x20) == 'n';
+}
+
+void readAscii(const Header& header, TextLines& lines, std::size_t remaining_bytes, Scan& scan) {
+  std::size_t values_per_point = 0;
+  for (const Field& field : header.fields) values_per_point += field.count;
+  // Column of each field's first value on a line.
+  std::vector<std::size_t> column(header.fields.size());
+  for (std::size_t i = 1; i < header.fields.size(); ++i) {
+    column[i] = column[i - 1] + header.fields[i - 1].count;
+  }
+  // Each value takes at least two characters: never reserve more than the file holds.
+  scan.points.reserve(std::min<std::uint64_t>(header.points, remaining_bytes / (2 * values_per_point) + 1));
+  for (std::uint64_t i = 0; i < header.points; ++i) {
+    std::vector<std::string_view> values;
+    do {
+      if (!lines.next()) {
+        lines.fail("file ends after " + std::to_string(i) + " of " + std::to_string(header.points) +
+                   " points");
+      }
+      values = lines.fields();
+    } while (values.empty());
+    if (values.size() != values_per_point) {
+      lines.fail("point line has " + std::to_string(values.size()) + " values, expected " +
+                 std::to_string(values_per_point));
+    }
+    const std::string_view x = values[column[header.x]];
+    const std::string_view y = values[column[header.y]];
+    const std::string_view z = values[column[header.z]];
+    if (isNanToken(x) || isNanToken(y) || isNanToken(z)) continue;  // PCL's "no return"
+    scan.points.emplace_back(lines.parseDouble(x), lines.parseDouble(y), lines.parseDouble(z));
+    if (header.label) {
+      const std::int64_t label = lines.parseInt(values[column[*header.label]]);
+      if (label < 0 && header.fields[*header.label].type == 'U') {
+        lines.fail("negative value for unsigned label");
+      }
+      scan.labels.push_back(checkedLabel(label,
+                                         [&] { return lines.sourceName() + ":" + std::to_string(lines.lineNumber()); }));
+    }
+  }
+  while (lines.next()) {
+    if (!lines.fields().empty()) {
+      lines.fail("more point lines than POINTS " + std::to_string(header.points));
+    }
+  }
+}
+
+// ---------------------------------------------------------------- writer helpers
+
+template <typename T>
+void appendNumber(std::string& out, T value) {
+  char buffer[40];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  out.append(buffer, result.ptr);
+}
+
+std::string makeHeader(const Scan& scan, bool with_labels, bool signed_labels, Encoding encoding) {
+  std::string header = "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n";
+  header += with_labels ? "FIELDS x y z label\nSIZE 4 4 4 4\n" : "FIELDS x y z\nSIZE 4 4 4\n";
+  header += with_labels ? (signed_labels ? "TYPE F F F I\nCOUNT 1 1 1 1\n" : "TYPE F F F U\nCOUNT 1 1 1 1\n")
+                        : "TYPE F F F\nCOUNT 1 1 1\n";
+  header += "WIDTH " + std::to_string(scan.size()) + "\nHEIGHT 1\nVIEWPOINT";
+  const Eigen::Vector3d translation = scan.pose.translation();
+  const Eigen::Quaterniond rotation = Eigen::Quaterniond(scan.pose.linear()).normalized();
+  for (const double value : {translation.x(), translation.y(), translation.z(), rotation.w(),
+                             rotation.x(), rotation.y(), rotation.z()}) {
+    header += ' ';
+    appendNumber(header, value);
+  }
+  header += "\nPOINTS " + std::to_string(scan.size()) + "\nDATA ";
+  header += encoding == Encoding::Ascii    ? "ascii\n"
+            : encoding == Encoding::Binary ? "binary\n"
+                                           : "binary_compressed\n";
+  return header;
+}
+
+}  // namespace
+
+Scan readPcd(const std::filesystem::path& path) {
+  const std::string source = path.string();
+  std::string bytes = readWholeFile(path);
+  MemoryBuffer buffer(bytes);
+  std::istream stream(&buffer);
+  TextLines lines(stream, source);
+  const Header header = parseHeader(lines);
+
+  Scan scan;
+  scan.pose = header.viewpoint;
+  const auto body_start = static_cast<std::size_t>(stream.tellg());
+  switch (header.encoding) {
+    case Encoding::Ascii: readAscii(header, lines, bytes.size() - body_start, scan); break;
+    case Encoding::Binary: readBinary(header, bytes, body_start, source, scan); break;
+    case Encoding::BinaryCompressed: readBinaryCompressed(header, bytes, body_start, source, scan); break;
+  }
+  return scan;
+}
+
+void writePcd(const std::filesystem::path& path, const Scan& scan, PcdEncoding encoding) {
+  const bool with_labels = !scan.labels.empty();
+  if (with_labels && scan.labels.size() != scan.points.size()) {
+    throw Error(path.string() + ": scan has " + std::to_string(scan.points.size()) + " points but " +
+                std::to_string(scan.labels.size()) + " labels");
+  }
+  // Unsigned labels as PCL's PointXYZL has them, unless a label is negative.
+  bool signed_labels = false;
+  for (const std::int32_t label : scan.labels) signed_labels |= label < 0;
+  const Encoding format = encoding == PcdEncoding::Ascii    ? Encoding::Ascii
+                          : encoding == PcdEncoding::Binary ? Encoding::Binary
+                                                            : Encoding::BinaryCompressed;
+  std::string out = makeHeader(scan, with_labels, signed_labels, format);
+  const std::size_t count = scan.size();
+  const std::size_t point_bytes = with_labels ? 16 : 12;
+
+  if (format == Encoding::Ascii) {
+    out.reserve(out.size() + count * (with_labels ? 48 : 40));
+    for (std::size_t i = 0; i < count; ++i) {
+      const Point& point = scan.points[i];
+      appendNumber(out, static_cast<float>(point.x()));
+      out += ' ';
+      appendNumber(out, static_cast<float>(point.y()));
+      out += ' ';
+      appendNumber(out, static_cast<float>(point.z()));
+      if (with_labels) {
+        out += ' ';
+        if (signed_labels) appendNumber(out, scan.labels[i]);
+        else appendNumber(out, static_cast<std::uint32_t>(scan.labels[i]));
+      }
+      out += '\n';
+    }
+  } else if (format == Encoding::Binary) {
+    const std::size_t header_bytes = out.size();
+    out.resize(header_bytes + count * point_bytes);
+    char* row = out.data() + header_bytes;
+    for (std::size_t i = 0; i < count; ++i, row += point_bytes) {
+      const Point& point = scan.points[i];
+      storeLittleEndian(row, static_cast<float>(point.x()));
+      storeLittleEndian(row + 4, static_cast<float>(point.y()));
+      storeLittleEndian(row + 8, static_cast<float>(point.z()));
+      if (with_labels) storeLittleEndian(row + 12, scan.labels[i]);
+    }
+  } else {
+    if (count > std::numeric_limits<std::uint32_t>::max() / point_bytes) {
+      throw Error(path.string() + ": " + std::to_string(count) +
+                  " points are too many for binary_compressed (4 GiB limit); use binary");
+    }
+    // Field by field, as PCL lays it out before compressing.
+    std::string unpacked(count * point_bytes, '\0');
+    for (std::size_t i = 0; i < count; ++i) {
+      const Point& point = scan.points[i];
+      storeLittleEndian(unpacked.data() + 4 * i, static_cast<float>(point.x()));
+      storeLittleEndian(unpacked.data() + 4 * (count + i), static_cast<float>(point.y()));
+      storeLittleEndian(unpacked.data() + 4 * (2 * count + i), static_cast<float>(point.z()));
+      if (with_labels) storeLittleEndian(unpacked.data() + 4 * (3 * count + i), scan.labels[i]);
+    }
+    // Incompressible input grows by one byte per 32 plus a little.
+    std::string packed(unpacked.size() + unpacked.size() / 16 + 64, '\0');
+    unsigned int packed_bytes = 0;
+    if (!unpacked.empty()) {
+      packed_bytes = lzf_compress(unpacked.data(), static_cast<unsigned int>(unpacked.size()),
+                                  packed.data(), static_cast<unsigned int>(packed.size()));
+      if (packed_bytes == 0) throw Error(path.string() + ": LZF compression failed");
+    }
+    char sizes[8];
+    storeLittleEndian(sizes, static_cast<std::uint32_t>(packed_bytes));
+    storeLittleEndian(sizes + 4, static_cast<std::uint32_t>(unpacked.size()));
+    out.append(sizes, 8);
+    out.append(packed.data(), packed_bytes);
+  }
+  writeAtomically(path, [&](std::ostream& stream) {
+    stream.write(out.data(), static_cast<std::streamsize>(out.size()));
+  });
+}
+
+}  // namespace mlmap::io
