@@ -2,6 +2,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "helpers.hpp"
@@ -109,7 +110,7 @@ TEST_CASE("Sim ray caster agrees with analytic answers") {
   SUBCASE("oblique rays against the brute-force plane answer") {
     const Eigen::Vector3d origin(2.0, 2.0, 1.0);
     for (int k = 0; k < 36; ++k) {
-      const double angle = k * 10.0 * M_PI / 180.0;
+      const double angle = k * 10.0 * std::numbers::pi / 180.0;
       const Eigen::Vector3d direction = Eigen::Vector3d(std::cos(angle), std::sin(angle), -0.3).normalized();
       // Nearest of the floor and the four walls (the crate is out of reach of these rays
       // only where it is not the nearest; check by comparing with every room plane).
