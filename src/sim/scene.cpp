@@ -469,8 +469,9 @@ void assignPlanes(SceneBuilder& builder, Scene& scene, const std::string& source
       GroundTruthPlane plane;
       plane.id = id;
       plane.surface_class = pending.surface_class;
-      plane.normal = pending.surface.normal;
-      plane.d = -plane.normal.dot(pending.surface.corner);
+      // Adding 0.0 turns -0.0 into 0.0, so the exported JSON reads cleanly.
+      plane.normal = (pending.surface.normal.array() + 0.0).matrix();
+      plane.d = -plane.normal.dot(pending.surface.corner) + 0.0;
       plane.name = pending.name;
       planes.emplace(id, plane);
     } else {
