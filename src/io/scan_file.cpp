@@ -1,0 +1,69 @@
+// Chooses a reader or writer by the file's extension, compared case-insensitively.
+#include "mlmap/io/scan_file.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <string>
+
+#include "mlmap/error.hpp"
+#include "mlmap/io/pcd.hpp"
+#include "mlmap/io/ply.hpp"
+#include "mlmap/io/scan_graph.hpp"
+#include "mlmap/io/threedtk.hpp"
+#include "mlmap/io/xyz.hpp"
+
+namespace mlmap::io {
+namespace {
+
+enum class Format { Xyz, Ply, Pcd, ThreeDtk, Graph };
+
+constexpr const char* kSupported = ".xyz .txt .pts .dat (XYZ text), .ply, .pcd, .3d (3DTK), .graph";
+
+Format formatOf(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension == ".xyz" || extension == ".txt" || extension == ".pts" || extension == ".dat") {
+    return Format::Xyz;
+  }
+  if (extension == ".ply") return Format::Ply;
+  if (extension == ".pcd") return Format::Pcd;
+  if (extension == ".3d") return Format::ThreeDtk;
+  if (extension == ".graph") return Format::Graph;
+  throw Error(path.string() + ": unknown scan format '" + path.extension().string() +
+              "' (supported: " + kSupported + ")");
+}
+
+std::vector<Scan> single(Scan scan) {
+  std::vector<Scan> scans;
+  scans.push_back(std::move(scan));  // a braced list would copy every point
+  return scans;
+}
+
+}  // namespace
+
+std::vector<Scan> readScans(const std::filesystem::path& path) {
+  const Format format = formatOf(path);
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
+  switch (format) {
+    case Format::Xyz: return single(readXyz(path));
+    case Format::Ply: return single(readPly(path));
+    case Format::Pcd: return single(readPcd(path));
+    case Format::ThreeDtk: return single(readThreeDtkScan(path));
+    case Format::Graph: return readScanGraph(path);
+  }
+  throw Error(path.string() + ": unhandled scan format");  // unreachable: formatOf covers every case
+}
+
+void writeScan(const std::filesystem::path& path, const Scan& scan) {
+  switch (formatOf(path)) {
+    case Format::Xyz: writeXyz(path, scan); return;
+    case Format::Ply: writePly(path, scan); return;
+    case Format::Pcd: writePcd(path, scan); return;
+    case Format::ThreeDtk: writeThreeDtkScan(path, scan); return;
+    case Format::Graph: writeScanGraph(path, {scan}); return;
+  }
+}
+
+}  // namespace mlmap::io
