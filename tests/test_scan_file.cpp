@@ -1,11 +1,10 @@
-#include "mlmap/io/scan_file.hpp"
-
 #include <doctest/doctest.h>
 
 #include <string>
 
 #include "helpers.hpp"
 #include "mlmap/error.hpp"
+#include "mlmap/io/scan_file.hpp"
 
 using mlmap::Error;
 using mlmap::Point;
@@ -85,8 +84,10 @@ TEST_CASE("scan_file: unknown extension names the file and the supported list") 
   TempDir dir;
   writeText(dir / "cloud.las", "whatever");
   CHECK_THROWS_WITH_AS(readScans(dir / "cloud.las"),
-                       doctest::Contains("cloud.las: unknown scan format '.las' (supported: .xyz"), Error);
-  CHECK_THROWS_WITH_AS(writeScan(dir / "noextension", smallScan()), doctest::Contains("noextension"), Error);
+                       doctest::Contains("cloud.las: unknown scan format '.las' (supported: .xyz"),
+                       Error);
+  CHECK_THROWS_WITH_AS(writeScan(dir / "noextension", smallScan()),
+                       doctest::Contains("noextension"), Error);
   CHECK_FALSE(std::filesystem::exists(dir / "noextension"));
 }
 
@@ -94,7 +95,8 @@ TEST_CASE("scan_file: missing file") {
   TempDir dir;
   for (const char* name : {"gone.xyz", "gone.ply", "gone.pcd", "gone.3d", "gone.graph"}) {
     CAPTURE(name);
-    CHECK_THROWS_WITH_AS(readScans(dir / name), doctest::Contains((std::string(name) + ": no such file").c_str()), Error);
+    CHECK_THROWS_WITH_AS(readScans(dir / name),
+                         doctest::Contains((std::string(name) + ": no such file").c_str()), Error);
   }
 }
 

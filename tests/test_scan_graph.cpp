@@ -1,17 +1,16 @@
-#include "mlmap/io/scan_graph.hpp"
-
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 
 #include "helpers.hpp"
 #include "mlmap/error.hpp"
+#include "mlmap/io/scan_graph.hpp"
 
 using mlmap::Error;
 using mlmap::Point;
@@ -29,10 +28,13 @@ std::vector<Scan> twoScans() {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> coordinate(-10.0, 10.0);
   std::vector<Scan> scans(2);
-  for (int i = 0; i < 300; ++i) scans[0].points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
-  for (int i = 0; i < 200; ++i) scans[1].points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
+  for (int i = 0; i < 300; ++i)
+    scans[0].points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
+  for (int i = 0; i < 200; ++i)
+    scans[1].points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
   scans[0].pose.translation() = Eigen::Vector3d(0.5, -1.25, 0.1);
-  scans[1].pose.linear() = Eigen::AngleAxisd(0.8, Eigen::Vector3d(0.2, -0.3, 1).normalized()).toRotationMatrix();
+  scans[1].pose.linear() =
+      Eigen::AngleAxisd(0.8, Eigen::Vector3d(0.2, -0.3, 1).normalized()).toRotationMatrix();
   scans[1].pose.translation() = Eigen::Vector3d(2.0, 1.5, -0.25);
   return scans;
 }
@@ -128,14 +130,15 @@ TEST_CASE("scan_graph: hostile binary files are rejected before allocating") {
     CHECK(message.find("points") != std::string::npos);
   }
   SUBCASE("truncated") {
-    CHECK(graphError(dir, good.substr(0, good.size() - 100)).find("bad.graph: byte") != std::string::npos);
+    CHECK(graphError(dir, good.substr(0, good.size() - 100)).find("bad.graph: byte") !=
+          std::string::npos);
   }
   SUBCASE("trailing garbage") {
     CHECK(graphError(dir, good + "xyz").find("bad.graph: byte") != std::string::npos);
   }
   SUBCASE("zero scans") {
-    CHECK(graphError(dir, std::string(8, '\0')).find("bad.graph: byte 0: scan graph holds no scans") !=
-          std::string::npos);
+    CHECK(graphError(dir, std::string(8, '\0'))
+              .find("bad.graph: byte 0: scan graph holds no scans") != std::string::npos);
   }
   SUBCASE("too short") {
     CHECK(graphError(dir, "ab").find("bad.graph: byte 0") != std::string::npos);
@@ -172,7 +175,8 @@ TEST_CASE("scan_graph: bad ASCII logs name file and line") {
     CHECK(graphError(dir, "NODE 0 0 0 0 0 0\n1 2 x\n").find("bad.graph:2") != std::string::npos);
   }
   SUBCASE("short point") {
-    CHECK(graphError(dir, "NODE 0 0 0 0 0 0\n1 2 3\n1 2\n").find("bad.graph:3") != std::string::npos);
+    CHECK(graphError(dir, "NODE 0 0 0 0 0 0\n1 2 3\n1 2\n").find("bad.graph:3") !=
+          std::string::npos);
   }
   SUBCASE("comments only") {
     CHECK(graphError(dir, "# nothing\n").find("bad.graph:1: no NODE") != std::string::npos);
@@ -181,10 +185,12 @@ TEST_CASE("scan_graph: bad ASCII logs name file and line") {
 
 TEST_CASE("scan_graph: missing file, and failed writes leave nothing") {
   TempDir dir;
-  CHECK_THROWS_WITH_AS(readScanGraph(dir / "none.graph"), doctest::Contains("none.graph: no such file"), Error);
+  CHECK_THROWS_WITH_AS(readScanGraph(dir / "none.graph"),
+                       doctest::Contains("none.graph: no such file"), Error);
   auto scans = twoScans();
   scans[1].points[3].x() = std::numeric_limits<double>::infinity();
-  CHECK_THROWS_WITH_AS(writeScanGraph(dir / "out.graph", scans), doctest::Contains("scan 1: point 3"), Error);
+  CHECK_THROWS_WITH_AS(writeScanGraph(dir / "out.graph", scans),
+                       doctest::Contains("scan 1: point 3"), Error);
   CHECK_THROWS_AS(writeScanGraph(dir / "out.graph", {}), Error);
   CHECK(std::filesystem::is_empty(dir.path()));
 }

@@ -1,8 +1,7 @@
-#include "mlmap/io/threedtk.hpp"
-
 #include <doctest/doctest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -10,6 +9,7 @@
 
 #include "helpers.hpp"
 #include "mlmap/error.hpp"
+#include "mlmap/io/threedtk.hpp"
 
 using mlmap::Error;
 using mlmap::Point;
@@ -31,16 +31,21 @@ Eigen::Matrix3d slam6dRotation(double rx, double ry, double rz) {
   const double sy = std::sin(ry), cy = std::cos(ry);
   const double sz = std::sin(rz), cz = std::cos(rz);
   Eigen::Matrix3d m;
+  // clang-format off
   m << cy * cz, -cy * sz, sy,
       sx * sy * cz + cx * sz, -sx * sy * sz + cx * cz, -sx * cy,
       -cx * sy * cz + sx * sz, cx * sy * sz + sx * cz, cx * cy;
+  // clang-format on
   return m;
 }
 
 // 3DTK (x right, y up, z forward, cm) to mlmap (x forward, y left, z up, m).
-Eigen::Vector3d fromThreeDtk(const Eigen::Vector3d& p) { return Eigen::Vector3d(p.z(), -p.x(), p.y()) / 100.0; }
+Eigen::Vector3d fromThreeDtk(const Eigen::Vector3d& p) {
+  return Eigen::Vector3d(p.z(), -p.x(), p.y()) / 100.0;
+}
 
-std::string threeDtkError(const TempDir& dir, const std::string& scan_text, const std::string& pose_text) {
+std::string threeDtkError(const TempDir& dir, const std::string& scan_text,
+                          const std::string& pose_text) {
   writeText(dir / "scan000.3d", scan_text);
   writeText(dir / "scan000.pose", pose_text);
   try {
@@ -74,7 +79,8 @@ PlaneFit fitHorizontalPlane(const std::vector<Point>& points, const Eigen::Vecto
     for (const Point& p : selected) fit.centroid += p;
     fit.centroid /= static_cast<double>(selected.size());
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-    for (const Point& p : selected) covariance += (p - fit.centroid) * (p - fit.centroid).transpose();
+    for (const Point& p : selected)
+      covariance += (p - fit.centroid) * (p - fit.centroid).transpose();
     fit.normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvectors().col(0);
     if (fit.normal.z() < 0) fit.normal = -fit.normal;
     fit.inliers = selected.size();
@@ -100,14 +106,18 @@ std::vector<Point> worldPoints(const Scan& scan, const Pose& pose) {
 
 // Fraction of `query` points with a `reference` point closer than `radius`,
 // found through a voxel hash of cell size `radius` (27 neighbouring cells).
-double overlapFraction(const std::vector<Point>& reference, const std::vector<Point>& query, double radius) {
+double overlapFraction(const std::vector<Point>& reference, const std::vector<Point>& query,
+                       double radius) {
   struct KeyHash {
     std::size_t operator()(const Eigen::Vector3i& key) const {
-      return static_cast<std::size_t>(key.x()) * 73856093u ^ static_cast<std::size_t>(key.y()) * 19349663u ^
+      return static_cast<std::size_t>(key.x()) * 73856093u ^
+             static_cast<std::size_t>(key.y()) * 19349663u ^
              static_cast<std::size_t>(key.z()) * 83492791u;
     }
   };
-  auto keyOf = [radius](const Point& p) { return Eigen::Vector3i((p / radius).array().floor().cast<int>()); };
+  auto keyOf = [radius](const Point& p) {
+    return Eigen::Vector3i((p / radius).array().floor().cast<int>());
+  };
   std::unordered_map<Eigen::Vector3i, std::vector<Point>, KeyHash> grid;
   for (const Point& p : reference) grid[keyOf(p)].push_back(p);
   std::size_t hits = 0;
@@ -192,10 +202,12 @@ TEST_CASE("threedtk: bad input names file and line") {
     CHECK(message.find("scan000.3d:2") != std::string::npos);
   }
   SUBCASE("nan point") {
-    CHECK(threeDtkError(dir, "1 2 nan\n", "0 0 0\n0 0 0\n").find("scan000.3d:1") != std::string::npos);
+    CHECK(threeDtkError(dir, "1 2 nan\n", "0 0 0\n0 0 0\n").find("scan000.3d:1") !=
+          std::string::npos);
   }
   SUBCASE("empty scan") {
-    CHECK(threeDtkError(dir, "", "0 0 0\n0 0 0\n").find("scan000.3d:1: no points") != std::string::npos);
+    CHECK(threeDtkError(dir, "", "0 0 0\n0 0 0\n").find("scan000.3d:1: no points") !=
+          std::string::npos);
   }
   SUBCASE("pose with five numbers") {
     const std::string message = threeDtkError(dir, "1 2 3\n", "0 0 0\n0 0\n");
@@ -203,10 +215,12 @@ TEST_CASE("threedtk: bad input names file and line") {
     CHECK(message.find("found 5") != std::string::npos);
   }
   SUBCASE("pose with seven numbers") {
-    CHECK(threeDtkError(dir, "1 2 3\n", "0 0 0\n0 0 0\n7\n").find("scan000.pose:3") != std::string::npos);
+    CHECK(threeDtkError(dir, "1 2 3\n", "0 0 0\n0 0 0\n7\n").find("scan000.pose:3") !=
+          std::string::npos);
   }
   SUBCASE("non-numeric pose") {
-    CHECK(threeDtkError(dir, "1 2 3\n", "0 0 0\nx 0 0\n").find("scan000.pose:2") != std::string::npos);
+    CHECK(threeDtkError(dir, "1 2 3\n", "0 0 0\nx 0 0\n").find("scan000.pose:2") !=
+          std::string::npos);
   }
   SUBCASE("missing pose file") {
     writeText(dir / "scan001.3d", "1 2 3\n");
@@ -224,7 +238,8 @@ TEST_CASE("threedtk: write then read round-trips points and pose") {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> coordinate(-30.0, 30.0);
   Scan scan;
-  for (int i = 0; i < 500; ++i) scan.points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
+  for (int i = 0; i < 500; ++i)
+    scan.points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
   scan.pose.linear() = (Eigen::AngleAxisd(2.5, Eigen::Vector3d(1, -2, 0.5).normalized()) *
                         Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitZ()))
                            .toRotationMatrix();
@@ -261,7 +276,8 @@ TEST_CASE("threedtk: 3DTK's example scans are level, in metres, and overlap in t
     return;
   }
   std::vector<Scan> scans;
-  for (const char* name : {"scan000.3d", "scan001.3d", "scan002.3d"}) scans.push_back(readThreeDtkScan(folder / name));
+  for (const char* name : {"scan000.3d", "scan001.3d", "scan002.3d"})
+    scans.push_back(readThreeDtkScan(folder / name));
   for (const Scan& scan : scans) CHECK(scan.size() == 81360);
 
   // Odometry: each scan further forward (+x), nearly the same height and side.

@@ -1,5 +1,3 @@
-#include "mlmap/io/tum_poses.hpp"
-
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -8,6 +6,7 @@
 
 #include "helpers.hpp"
 #include "mlmap/error.hpp"
+#include "mlmap/io/tum_poses.hpp"
 
 using mlmap::Error;
 using mlmap::Pose;
@@ -55,7 +54,8 @@ TEST_CASE("tum: reads stamps, translations and quaternions") {
   CHECK(poses[0].pose.linear().isApprox(Eigen::Matrix3d::Identity()));
   CHECK(poses[1].pose.translation() == Eigen::Vector3d(-1, 0.5, 0));
   // x axis maps to y.
-  CHECK((poses[1].pose.linear() * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY()).norm() < 1e-12);
+  CHECK((poses[1].pose.linear() * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY()).norm() <
+        1e-12);
 }
 
 TEST_CASE("tum: a non-unit quaternion is normalised") {
@@ -96,7 +96,8 @@ TEST_CASE("tum: bad input names file and line") {
     CHECK(tumError(dir, "").find("poses.txt:1: no poses") != std::string::npos);
   }
   SUBCASE("missing file") {
-    CHECK_THROWS_WITH_AS(readTumPoses(dir / "none.txt"), doctest::Contains("none.txt: no such file"), Error);
+    CHECK_THROWS_WITH_AS(readTumPoses(dir / "none.txt"),
+                         doctest::Contains("none.txt: no such file"), Error);
   }
 }
 

@@ -1,5 +1,3 @@
-#include "mlmap/io/xyz.hpp"
-
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -10,6 +8,7 @@
 
 #include "helpers.hpp"
 #include "mlmap/error.hpp"
+#include "mlmap/io/xyz.hpp"
 
 using mlmap::Error;
 using mlmap::Scan;
@@ -89,9 +88,7 @@ TEST_CASE("xyz: bad input names file and line") {
     CHECK(message.find("bad.xyz:2") != std::string::npos);
     CHECK(message.find("not finite") != std::string::npos);
   }
-  SUBCASE("inf") {
-    CHECK(xyzError(dir, "# c\n-inf 2 3\n").find("bad.xyz:2") != std::string::npos);
-  }
+  SUBCASE("inf") { CHECK(xyzError(dir, "# c\n-inf 2 3\n").find("bad.xyz:2") != std::string::npos); }
   SUBCASE("overflowing number") {
     CHECK(xyzError(dir, "1e999 2 3\n").find("bad.xyz:1") != std::string::npos);
   }
@@ -120,7 +117,8 @@ TEST_CASE("xyz: bad input names file and line") {
 
 TEST_CASE("xyz: missing file") {
   TempDir dir;
-  CHECK_THROWS_WITH_AS(readXyz(dir / "nope.xyz"), doctest::Contains("nope.xyz: no such file"), Error);
+  CHECK_THROWS_WITH_AS(readXyz(dir / "nope.xyz"), doctest::Contains("nope.xyz: no such file"),
+                       Error);
 }
 
 TEST_CASE("xyz: write then read round-trips to 1 um, labels exactly") {
@@ -132,9 +130,9 @@ TEST_CASE("xyz: write then read round-trips to 1 um, labels exactly") {
     scan.points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
     scan.labels.push_back(i % 5 - 2);
   }
-  scan.points.emplace_back(0.0, -0.0, 1e-9);        // rounds to zero
+  scan.points.emplace_back(0.0, -0.0, 1e-9);  // rounds to zero
   scan.labels.push_back(std::numeric_limits<std::int32_t>::min());
-  scan.points.emplace_back(1e15, -2.5e13, 123.0);   // beyond the fixed-point range
+  scan.points.emplace_back(1e15, -2.5e13, 123.0);  // beyond the fixed-point range
   scan.labels.push_back(std::numeric_limits<std::int32_t>::max());
   writeXyz(dir / "out.xyz", scan);
   const Scan back = readXyz(dir / "out.xyz");

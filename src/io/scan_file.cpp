@@ -47,22 +47,38 @@ std::vector<Scan> readScans(const std::filesystem::path& path) {
   std::error_code error;
   if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
   switch (format) {
-    case Format::Xyz: return single(readXyz(path));
-    case Format::Ply: return single(readPly(path));
-    case Format::Pcd: return single(readPcd(path));
-    case Format::ThreeDtk: return single(readThreeDtkScan(path));
-    case Format::Graph: return readScanGraph(path);
+    case Format::Xyz:
+      return single(readXyz(path));
+    case Format::Ply:
+      return single(readPly(path));
+    case Format::Pcd:
+      return single(readPcd(path));
+    case Format::ThreeDtk:
+      return single(readThreeDtkScan(path));
+    case Format::Graph:
+      return readScanGraph(path);
   }
-  throw Error(path.string() + ": unhandled scan format");  // unreachable: formatOf covers every case
+  // Unreachable: formatOf() either names a handled format or throws.
+  throw Error(path.string() + ": unhandled scan format");
 }
 
 void writeScan(const std::filesystem::path& path, const Scan& scan) {
   switch (formatOf(path)) {
-    case Format::Xyz: writeXyz(path, scan); return;
-    case Format::Ply: writePly(path, scan); return;
-    case Format::Pcd: writePcd(path, scan); return;
-    case Format::ThreeDtk: writeThreeDtkScan(path, scan); return;
-    case Format::Graph: writeScanGraph(path, {scan}); return;
+    case Format::Xyz:
+      writeXyz(path, scan);
+      return;
+    case Format::Ply:
+      writePly(path, scan);
+      return;
+    case Format::Pcd:
+      writePcd(path, scan);
+      return;
+    case Format::ThreeDtk:
+      writeThreeDtkScan(path, scan);
+      return;
+    case Format::Graph:
+      writeScanGraph(path, {scan});
+      return;
   }
 }
 

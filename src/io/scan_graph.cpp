@@ -53,11 +53,12 @@ constexpr double kMinQuaternionNorm = 1e-6;
 
 // Where each node's data starts, as found by walking the binary layout.
 struct NodeLayout {
-  std::uint64_t offset = 0;       // of the node's point count
+  std::uint64_t offset = 0;  // of the node's point count
   std::uint32_t point_count = 0;
 };
 
-std::uint32_t readCount(std::ifstream& in, const std::filesystem::path& path, std::uint64_t offset) {
+std::uint32_t readCount(std::ifstream& in, const std::filesystem::path& path,
+                        std::uint64_t offset) {
   unsigned char bytes[4];
   in.seekg(static_cast<std::streamoff>(offset));
   in.read(reinterpret_cast<char*>(bytes), 4);
@@ -68,18 +69,21 @@ std::uint32_t readCount(std::ifstream& in, const std::filesystem::path& path, st
 
 // Checks that the counts in the file are consistent with its size before any
 // memory is allocated for them.
-std::vector<NodeLayout> walkBinaryLayout(const std::filesystem::path& path, std::uint64_t file_size) {
+std::vector<NodeLayout> walkBinaryLayout(const std::filesystem::path& path,
+                                         std::uint64_t file_size) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open for reading");
   if (file_size < 2 * kCountBytes) {
-    failAtByte(path, 0, "file too short for a scan graph (" + std::to_string(file_size) + " bytes)");
+    failAtByte(path, 0,
+               "file too short for a scan graph (" + std::to_string(file_size) + " bytes)");
   }
   const std::uint32_t node_count = readCount(in, path, 0);
   std::uint64_t offset = kCountBytes;
   if (node_count == 0) failAtByte(path, 0, "scan graph holds no scans");
   if (static_cast<std::uint64_t>(node_count) * kMinNodeBytes > file_size - offset) {
-    failAtByte(path, 0, "header claims " + std::to_string(node_count) + " scans but only " +
-                            std::to_string(file_size - offset) + " bytes follow");
+    failAtByte(path, 0,
+               "header claims " + std::to_string(node_count) + " scans but only " +
+                   std::to_string(file_size - offset) + " bytes follow");
   }
   std::vector<NodeLayout> nodes;
   nodes.reserve(node_count);
@@ -88,12 +92,13 @@ std::vector<NodeLayout> walkBinaryLayout(const std::filesystem::path& path, std:
       failAtByte(path, offset, "file ends inside scan " + std::to_string(node));
     }
     const std::uint32_t point_count = readCount(in, path, offset);
-    const std::uint64_t node_bytes =
-        kCountBytes + static_cast<std::uint64_t>(point_count) * kVectorBytes + kPoseBytes + kNodeIdBytes;
+    const std::uint64_t node_bytes = kCountBytes +
+                                     static_cast<std::uint64_t>(point_count) * kVectorBytes +
+                                     kPoseBytes + kNodeIdBytes;
     if (node_bytes > file_size - offset) {
-      failAtByte(path, offset, "scan " + std::to_string(node) + " claims " +
-                                   std::to_string(point_count) + " points but only " +
-                                   std::to_string(file_size - offset) + " bytes remain");
+      failAtByte(path, offset,
+                 "scan " + std::to_string(node) + " claims " + std::to_string(point_count) +
+                     " points but only " + std::to_string(file_size - offset) + " bytes remain");
     }
     nodes.push_back({offset, point_count});
     offset += node_bytes;
@@ -102,9 +107,9 @@ std::vector<NodeLayout> walkBinaryLayout(const std::filesystem::path& path, std:
   const std::uint32_t edge_count = readCount(in, path, offset);
   const std::uint64_t edge_bytes = static_cast<std::uint64_t>(edge_count) * kEdgeBytes;
   if (edge_bytes != file_size - offset - kCountBytes) {
-    failAtByte(path, offset, "edge count " + std::to_string(edge_count) + " needs " +
-                                 std::to_string(edge_bytes) + " bytes but " +
-                                 std::to_string(file_size - offset - kCountBytes) + " follow");
+    failAtByte(path, offset,
+               "edge count " + std::to_string(edge_count) + " needs " + std::to_string(edge_bytes) +
+                   " bytes but " + std::to_string(file_size - offset - kCountBytes) + " follow");
   }
   return nodes;
 }
@@ -143,20 +148,25 @@ std::vector<Scan> readBinaryGraph(const std::filesystem::path& path, std::uint64
   for (const octomap::ScanNode* node : graph) {
     const NodeLayout& where = layout[index];
     if (node->scan == nullptr || node->scan->size() != where.point_count) {
-      failAtByte(path, where.offset, "scan " + std::to_string(index) + ": octomap read a different point count");
+      failAtByte(path, where.offset,
+                 "scan " + std::to_string(index) + ": octomap read a different point count");
     }
     Scan scan;
     const std::uint64_t pose_offset = where.offset + kCountBytes + where.point_count * kVectorBytes;
     const auto pose = toPose(node->pose);
-    if (!pose) failAtByte(path, pose_offset, "scan " + std::to_string(index) + ": pose is not finite or its quaternion is zero");
+    if (!pose) {
+      failAtByte(path, pose_offset,
+                 "scan " + std::to_string(index) + ": pose is not finite or its quaternion is zero");
+    }
     scan.pose = *pose;
     scan.points.reserve(node->scan->size());
     for (std::size_t i = 0; i < node->scan->size(); ++i) {
       const octomap::point3d& p = (*node->scan)[i];
       const Point point(p.x(), p.y(), p.z());
       if (!point.allFinite()) {
-        failAtByte(path, where.offset + kCountBytes + i * kVectorBytes,
-                   "scan " + std::to_string(index) + ": point " + std::to_string(i) + " is not finite");
+        failAtByte(
+            path, where.offset + kCountBytes + i * kVectorBytes,
+            "scan " + std::to_string(index) + ": point " + std::to_string(i) + " is not finite");
       }
       scan.points.push_back(point);
     }
@@ -176,7 +186,8 @@ std::vector<Scan> readAsciiGraph(const std::filesystem::path& path) {
     if (fields.empty()) continue;
     if (fields[0] == "NODE") {
       if (fields.size() != 7) {
-        lines.fail("expected 'NODE x y z roll pitch yaw', found " + std::to_string(fields.size()) + " fields");
+        lines.fail("expected 'NODE x y z roll pitch yaw', found " + std::to_string(fields.size()) +
+                   " fields");
       }
       double values[6];
       for (int i = 0; i < 6; ++i) values[i] = lines.parseDouble(fields[i + 1]);
@@ -221,7 +232,8 @@ bool looksLikeAscii(const std::filesystem::path& path) {
 std::vector<Scan> readScanGraph(const std::filesystem::path& path) {
   std::error_code error;
   if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
-  if (!std::filesystem::is_regular_file(path, error)) throw Error(path.string() + ": not a regular file");
+  if (!std::filesystem::is_regular_file(path, error))
+    throw Error(path.string() + ": not a regular file");
   const std::uint64_t file_size = std::filesystem::file_size(path, error);
   if (error) throw Error(path.string() + ": cannot read size (" + error.message() + ")");
   if (looksLikeAscii(path)) return readAsciiGraph(path);
@@ -233,7 +245,8 @@ void writeScanGraph(const std::filesystem::path& path, const std::vector<Scan>& 
   octomap::ScanGraph graph;
   for (std::size_t index = 0; index < scans.size(); ++index) {
     const Scan& scan = scans[index];
-    if (scan.points.size() > 0xFFFFFFFFu) throw Error(path.string() + ": scan " + std::to_string(index) + " too large");
+    if (scan.points.size() > 0xFFFFFFFFu)
+      throw Error(path.string() + ": scan " + std::to_string(index) + " too large");
     if (!scan.pose.matrix().allFinite()) {
       throw Error(path.string() + ": scan " + std::to_string(index) + ": pose is not finite");
     }
@@ -242,15 +255,17 @@ void writeScanGraph(const std::filesystem::path& path, const std::vector<Scan>& 
     for (std::size_t i = 0; i < scan.points.size(); ++i) {
       const Point& p = scan.points[i];
       if (!p.allFinite()) {
-        throw Error(path.string() + ": scan " + std::to_string(index) + ": point " + std::to_string(i) +
-                    " is not finite");
+        throw Error(path.string() + ": scan " + std::to_string(index) + ": point " +
+                    std::to_string(i) + " is not finite");
       }
-      cloud->push_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+      cloud->push_back(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                       static_cast<float>(p.z()));
     }
     const Eigen::Quaterniond rotation(scan.pose.linear());
     const Eigen::Vector3d& t = scan.pose.translation();
     const octomath::Pose6D pose(
-        octomath::Vector3(static_cast<float>(t.x()), static_cast<float>(t.y()), static_cast<float>(t.z())),
+        octomath::Vector3(static_cast<float>(t.x()), static_cast<float>(t.y()),
+                          static_cast<float>(t.z())),
         octomath::Quaternion(static_cast<float>(rotation.w()), static_cast<float>(rotation.x()),
                              static_cast<float>(rotation.y()), static_cast<float>(rotation.z())));
     graph.addNode(cloud.release(), pose);  // the graph owns the cloud from here

@@ -42,9 +42,11 @@ constexpr double kPi = 3.14159265358979323846;
 // 3DTK (left-handed, y up, z forward) -> mlmap (right-handed, z up, x forward).
 Eigen::Matrix3d axisChange() {
   Eigen::Matrix3d a;
+  // clang-format off
   a << 0, 0, 1,
       -1, 0, 0,
        0, 1, 0;
+  // clang-format on
   return a;
 }
 
@@ -63,8 +65,8 @@ std::ifstream openForReading(const std::filesystem::path& path) {
 bool isOldHeader(const std::vector<std::string_view>& fields) {
   if (fields.size() != 3 || fields[1] != "x") return false;
   for (const auto field : {fields[0], fields[2]}) {
-    if (field.empty() || !std::all_of(field.begin(), field.end(),
-                                      [](char c) { return c >= '0' && c <= '9'; })) {
+    if (field.empty() ||
+        !std::all_of(field.begin(), field.end(), [](char c) { return c >= '0' && c <= '9'; })) {
       return false;
     }
   }
@@ -79,7 +81,8 @@ Pose readPoseFile(const std::filesystem::path& path) {
   std::vector<double> values;
   while (lines.next()) {
     for (const auto field : lines.fields()) {
-      if (values.size() == 6) lines.fail("more than 6 numbers (tx ty tz in cm, rx ry rz in degrees)");
+      if (values.size() == 6)
+        lines.fail("more than 6 numbers (tx ty tz in cm, rx ry rz in degrees)");
       values.push_back(lines.parseDouble(field));
     }
   }
@@ -144,7 +147,8 @@ Scan readThreeDtkScan(const std::filesystem::path& path) {
     if (fields.empty()) continue;
     if (lines.lineNumber() == 1 && isOldHeader(fields)) continue;
     if (fields.size() < 3) {
-      lines.fail("expected at least 3 fields (x y z in cm), found " + std::to_string(fields.size()));
+      lines.fail("expected at least 3 fields (x y z in cm), found " +
+                 std::to_string(fields.size()));
     }
     // Columns after x y z (reflectance, colour in the uos_r/uos_rgb variants) are ignored.
     const Eigen::Vector3d point_3dtk(lines.parseDouble(fields[0]), lines.parseDouble(fields[1]),

@@ -72,13 +72,14 @@ void writeTumPoses(const std::filesystem::path& path, const std::vector<StampedP
     const double norm = rotation.norm();
     if (!std::isfinite(stamped.stamp) || !stamped.pose.matrix().allFinite() ||
         !(norm >= kMinQuaternionNorm) || !std::isfinite(norm)) {
-      throw Error(path.string() + ": pose " + std::to_string(index) + " is not finite or not a rotation");
+      throw Error(path.string() + ": pose " + std::to_string(index) +
+                  " is not finite or not a rotation");
     }
     rotation.coeffs() /= norm;
     if (rotation.w() < 0.0) rotation.coeffs() = -rotation.coeffs();  // one sign per rotation
     const Eigen::Vector3d& t = stamped.pose.translation();
-    const double values[kFieldsPerPose] = {stamped.stamp, t.x(), t.y(), t.z(),
-                                           rotation.x(), rotation.y(), rotation.z(), rotation.w()};
+    const double values[kFieldsPerPose] = {stamped.stamp, t.x(),        t.y(),        t.z(),
+                                           rotation.x(),  rotation.y(), rotation.z(), rotation.w()};
     for (std::size_t i = 0; i < kFieldsPerPose; ++i) {
       if (i > 0) text.push_back(' ');
       appendNumber(text, values[i]);

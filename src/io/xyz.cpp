@@ -69,7 +69,6 @@ class Parser {
   Parser(const std::string& source, const std::string& data)
       : source_(source), position_(data.data()), end_(data.data() + data.size()) {}
 
-  const char* position() const { return position_; }
   bool atEnd() const { return position_ >= end_; }
   std::size_t lineNumber() const { return line_number_; }
 
@@ -218,8 +217,8 @@ Scan readXyz(const std::filesystem::path& path) {
 void writeXyz(const std::filesystem::path& path, const Scan& scan) {
   const bool labelled = !scan.labels.empty();
   if (labelled && scan.labels.size() != scan.points.size()) {
-    throw Error(path.string() + ": scan has " + std::to_string(scan.labels.size()) + " labels for " +
-                std::to_string(scan.points.size()) + " points");
+    throw Error(path.string() + ": scan has " + std::to_string(scan.labels.size()) +
+                " labels for " + std::to_string(scan.points.size()) + " points");
   }
   for (std::size_t index = 0; index < scan.points.size(); ++index) {
     if (!scan.points[index].allFinite()) {
