@@ -9,6 +9,7 @@
 
 #include <octomap/AbstractOcTree.h>
 
+#include "captured_cerr.hpp"
 #include "crc32.hpp"
 #include "mlmap/error.hpp"
 #include "mlmap/io/atomic_file.hpp"
@@ -114,6 +115,7 @@ void writeMap(const std::filesystem::path& path, const Map& map) {
   std::string octree_bytes;
   if (map.hasOctree()) {
     std::ostringstream stream;
+    const CapturedCerr quiet;
     map.octree().write(stream);
     octree_bytes = std::move(stream).str();
   }
@@ -205,9 +207,12 @@ Map readMap(const std::filesystem::path& path) {
   if (config.with_octree) {
     const std::size_t octree_offset = in.offset();
     std::istringstream stream(std::string(in.take(octree_size, "the OcTree")));
+    const CapturedCerr octomap_says;
     std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(stream));
     auto* octree = dynamic_cast<octomap::OcTree*>(tree.get());
-    if (octree == nullptr) in.failAt(octree_offset, "the embedded OcTree cannot be read");
+    if (octree == nullptr) {
+      in.failAt(octree_offset, "the embedded OcTree cannot be read (" + octomap_says.text() + ")");
+    }
     tree.release();
     try {
       map.setOctree(std::unique_ptr<octomap::OcTree>(octree));

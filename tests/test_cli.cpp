@@ -1,0 +1,127 @@
+// The mlmap CLI end to end: simulate -> build -> info, and one clear line for bad input.
+#include <doctest/doctest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "helpers.hpp"
+
+namespace {
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+CommandResult runCli(const std::string& arguments) {
+  const std::string command = std::string(MLMAP_CLI_PATH) + " " + arguments + " 2>&1";
+  CommandResult result;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  char buffer[4096];
+  std::size_t count = 0;
+  while ((count = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, count);
+  const int status = ::pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+// A 4 × 3 × 2.5 m box room scanned from two poses with a coarse pattern: seconds, not minutes.
+const char* kBoxRoom = R"({
+  "name": "box room",
+  "scan_pattern": {"tilt_start_deg": -60, "tilt_end_deg": 60, "tilt_step_deg": 2,
+                   "angular_step_deg": 1, "range_sigma": 0.005, "mount_height": 0.6},
+  "poses": [{"x": 1.5, "y": 1.5, "yaw_deg": 0}, {"x": 2.5, "y": 1.5, "yaw_deg": 90}],
+  "surfaces": [
+    {"type": "box", "min": [0, 0, 0], "max": [4, 3, 2.5], "class": "wall",
+     "classes": {"bottom": "floor", "top": "ceiling"}}
+  ]
+})";
+
+std::size_t lineCount(const std::string& text) {
+  return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+}  // namespace
+
+TEST_CASE("CLI: --help on every subcommand, and an unknown subcommand fails") {
+  for (const char* command : {"", "simulate ", "build ", "info "}) {
+    const auto result = runCli(std::string(command) + "--help");
+    CHECK(result.exit_code == 0);
+    CHECK(result.output.find("Usage") != std::string::npos);
+  }
+  CHECK(runCli("frobnicate").exit_code != 0);
+}
+
+TEST_CASE("CLI: the lab scene goes from simulate to build to info") {
+  mlmap::test::TempDir dir;
+  const std::string scene = (mlmap::test::sourceDir() / "maps" / "lab.json").string();
+  const std::string out = (dir / "lab").string();
+  auto result = runCli("--quiet simulate " + scene + " -o " + out);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  CHECK(std::filesystem::exists(dir / "lab" / "scan_007.xyz"));
+  CHECK(std::filesystem::exists(dir / "lab" / "poses_odom.txt"));
+  std::string scans;
+  for (int k = 0; k < 8; ++k) scans += " " + out + "/scan_00" + std::to_string(k) + ".xyz";
+  result = runCli("--quiet build -o " + out + "/lab.mlmap --cell-size 0.1 --poses " + out +
+                  "/poses_true.txt" + scans);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  result = runCli("info --json " + out + "/lab.mlmap");
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  const auto info = nlohmann::json::parse(result.output);
+  CHECK(info["cells"].get<int>() > 5000);  // 8.3 × 11.4 m at 0.1 m is ~9,500 cells
+  CHECK(info["blocks"]["vertical"].get<int>() > 500);
+  CHECK(info["bounds"]["max"][0].get<double>() - info["bounds"]["min"][0].get<double>() ==
+        doctest::Approx(8.3).epsilon(0.05));
+  CHECK(info["bounds"]["max"][1].get<double>() - info["bounds"]["min"][1].get<double>() ==
+        doctest::Approx(11.4).epsilon(0.05));
+  CHECK(info["octree"]["occupied_leaves"].get<int>() > 1000);
+}
+
+TEST_CASE("CLI: bad input ends with one line naming the file, exit code 1, no output file") {
+  mlmap::test::TempDir dir;
+  mlmap::test::writeText(dir / "room.json", kBoxRoom);
+  auto result = runCli("--quiet simulate " + (dir / "room.json").string() + " -o " +
+                       (dir / "room").string());
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  const std::string scans =
+      (dir / "room" / "scan_000.xyz").string() + " " + (dir / "room" / "scan_001.xyz").string();
+  const std::string map = (dir / "map.mlmap").string();
+
+  SUBCASE("a pose file with fewer poses than scans") {
+    mlmap::test::writeText(dir / "one.txt", "0 0 0 0 0 0 0 1\n");
+    result = runCli("--quiet build -o " + map + " --poses " + (dir / "one.txt").string() + " " + scans);
+    CHECK(result.exit_code == 1);
+    CHECK(lineCount(result.output) == 1);
+    CHECK(result.output.find("one.txt") != std::string::npos);
+  }
+  SUBCASE("a scan with a NaN on line 3") {
+    mlmap::test::writeText(dir / "bad.xyz", "0 0 0\n1 1 1\n1 nan 1\n");
+    result = runCli("--quiet build -o " + map + " " + (dir / "bad.xyz").string());
+    CHECK(result.exit_code == 1);
+    CHECK(lineCount(result.output) == 1);
+    CHECK(result.output.find("bad.xyz:3") != std::string::npos);
+  }
+  SUBCASE("a damaged map") {
+    mlmap::test::writeText(dir / "junk.mlmap", "not a map at all");
+    result = runCli("info " + (dir / "junk.mlmap").string());
+    CHECK(result.exit_code == 1);
+    CHECK(lineCount(result.output) == 1);
+    CHECK(result.output.find("junk.mlmap") != std::string::npos);
+  }
+  SUBCASE("a scene with a negative size") {
+    mlmap::test::writeText(dir / "neg.json", R"({"poses": [{"x": 0, "y": 0}], "surfaces": [
+      {"type": "box", "min": [0, 0, 0], "max": [-1, 3, 2]}]})");
+    result = runCli("--quiet simulate " + (dir / "neg.json").string() + " -o " + (dir / "neg").string());
+    CHECK(result.exit_code == 1);
+    CHECK(result.output.find("neg.json") != std::string::npos);
+  }
+  CHECK_FALSE(std::filesystem::exists(map));
+  // A good build over the same scans works.
+  result = runCli("--quiet build -o " + map + " --poses " + (dir / "room" / "poses_true.txt").string() +
+                  " " + scans);
+  CHECK_MESSAGE(result.exit_code == 0, result.output);
+  CHECK(std::filesystem::exists(map));
+}
