@@ -376,6 +376,19 @@ TEST_CASE("pcd: bad binary bodies fail naming file and byte") {
   CHECK_MESSAGE(contains(message, "bad.pcd: byte " + std::to_string(body_start + 42)), message);
   CHECK_MESSAGE(contains(message, "4 points"), message);
 
+  // The header is the whole file, without a final newline.
+  for (const std::string data : {"binary", "binary_compressed"}) {
+    bytes = headerFor("1", data);
+    bytes.pop_back();
+    writeText(path, bytes);
+    message = errorOf([&] { readPcd(path); });
+    CHECK_MESSAGE(contains(message, "bad.pcd: byte " + std::to_string(bytes.size())), message);
+    bytes = headerFor("0", data);
+    bytes.pop_back();
+    writeText(path, bytes);
+    CHECK(readPcd(path).size() == 0);
+  }
+
   // A huge organized cloud claimed: rejected before allocating.
   bytes = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 4000000000\nHEIGHT 100000\nDATA binary\n";
   for (int i = 0; i < 30; ++i) put<float>(bytes, 1.0F);

@@ -325,6 +325,17 @@ TEST_CASE("ply: bad binary bodies fail naming file and byte") {
   message = errorOf([&] { readPly(path); });
   CHECK_MESSAGE(contains(message, "bad.ply:8:"), message);
 
+  // The header is the whole file, without a final newline.
+  bytes = headerFor("1");
+  bytes.pop_back();
+  writeText(path, bytes);
+  message = errorOf([&] { readPly(path); });
+  CHECK_MESSAGE(contains(message, "bad.ply: byte " + std::to_string(bytes.size())), message);
+  bytes = headerFor("0");
+  bytes.pop_back();
+  writeText(path, bytes);
+  CHECK(readPly(path).size() == 0);
+
   // NaN coordinate in binary.
   bytes = headerFor("2");
   const std::size_t second_row = bytes.size() + 12;

@@ -368,6 +368,7 @@ constexpr std::uint64_t kMaxLzfExpansion = 88;
 
 void readBinaryCompressed(const Header& header, const std::string& bytes, std::size_t start,
                           const std::string& source, Scan& scan) {
+  if (header.points == 0 && bytes.size() - start < 8) return;  // nothing to compress
   if (bytes.size() - start < 8) {
     throw Error(byteWhere(source, bytes.size()) +
                 ": data ends before the compressed and uncompressed sizes (expected " +
@@ -510,6 +511,8 @@ Scan readPcd(const std::filesystem::path& path) {
 
   Scan scan;
   scan.pose = header.viewpoint;
+  // A header ending without '\n' leaves eofbit set, which would make tellg() fail.
+  stream.clear();
   const auto body_start = static_cast<std::size_t>(stream.tellg());
   switch (header.encoding) {
     case Encoding::Ascii: readAscii(header, lines, bytes.size() - body_start, scan); break;

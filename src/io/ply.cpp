@@ -490,6 +490,8 @@ Scan readPly(const std::filesystem::path& path) {
   if (vertex == nullptr) lines.fail("header has no 'element vertex'");
   const VertexLayout layout = findVertexLayout(*vertex, source);
 
+  // A header ending without '\n' leaves eofbit set, which would make tellg() fail.
+  stream.clear();
   const auto body_start = static_cast<std::size_t>(stream.tellg());
   Scan scan;
   if (header.format == Format::Ascii) {
