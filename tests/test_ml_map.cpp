@@ -233,3 +233,37 @@ TEST_CASE("MLMap insertBlock: a horizontal block fuses, a vertical one joins wha
   CHECK_THROWS_AS(map.insertBlock(cell, Block{0.0F, 0.0F, 0.0F, 0, BlockKind::Horizontal}),
                   mlmap::Error);
 }
+
+TEST_CASE("MLMap insertScan gives exactly the blocks of point-by-point insertion") {
+  std::mt19937 random(9);
+  std::uniform_real_distribution<double> xy(-1.0, 1.0);
+  std::uniform_real_distribution<double> z(0.0, 2.5);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  mlmap::Scan scan;
+  scan.pose = Eigen::Translation3d(0.3, -0.2, 0.5) * Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ());
+  for (int k = 0; k < 20000; ++k) {
+    scan.points.emplace_back(xy(random), xy(random), noise(random));           // floor
+    scan.points.emplace_back(xy(random), xy(random), 2.0 + noise(random));     // ceiling
+    scan.points.emplace_back(0.5 + noise(random), xy(random), z(random));      // wall
+    scan.points.emplace_back(xy(random) * 0.3, xy(random) * 0.3, 0.7 + noise(random));  // table
+    scan.variances.insert(scan.variances.end(), 4, 1e-4);
+  }
+  MLMap by_scan(kCell);
+  by_scan.insertScan(scan);
+  MLMap by_point(kCell);
+  for (std::size_t k = 0; k < scan.size(); ++k) by_point.insert(scan.worldPoint(k), scan.variance(k));
+  REQUIRE(by_scan.blockCount() == by_point.blockCount());
+  REQUIRE(by_scan.cellCount() == by_point.cellCount());
+  for (std::size_t n = 0; n < by_point.cellCount(); ++n) {
+    const auto expected = by_point.blocksAt(n);
+    const auto actual = by_scan.blocks(by_point.cellAt(n));
+    REQUIRE(actual.size() == expected.size());
+    for (std::size_t k = 0; k < expected.size(); ++k) {
+      CHECK(actual[k].height == expected[k].height);
+      CHECK(actual[k].depth == expected[k].depth);
+      CHECK(actual[k].variance == expected[k].variance);
+      CHECK(actual[k].kind == expected[k].kind);
+    }
+  }
+  CHECK(by_scan.stats().vertical_blocks > 0);
+}

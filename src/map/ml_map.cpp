@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "mlmap/error.hpp"
 
@@ -54,6 +55,44 @@ void updateBlock(Block& block, double z, double variance) {
   } else if (z < bottom) {
     block.depth = static_cast<float>(height - z);
   }
+}
+
+// Indices of `cells` in an order that groups equal cells, keeping scan order within
+// each cell (a stable LSD radix sort on the cell's offset from the scan's corner).
+std::vector<std::uint32_t> sortedByCell(const std::vector<CellIndex>& cells) {
+  std::int64_t min_i = cells[0].i, max_i = cells[0].i, min_j = cells[0].j, max_j = cells[0].j;
+  for (const CellIndex& cell : cells) {
+    min_i = std::min<std::int64_t>(min_i, cell.i);
+    max_i = std::max<std::int64_t>(max_i, cell.i);
+    min_j = std::min<std::int64_t>(min_j, cell.j);
+    max_j = std::max<std::int64_t>(max_j, cell.j);
+  }
+  const auto width = static_cast<std::uint64_t>(max_j - min_j + 1);
+  const auto height = static_cast<std::uint64_t>(max_i - min_i + 1);
+  std::vector<std::uint32_t> order(cells.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>(k);
+  auto key = [&](std::uint32_t k) {
+    return static_cast<std::uint64_t>(cells[k].i - min_i) * width +
+           static_cast<std::uint64_t>(cells[k].j - min_j);
+  };
+  if (height > (std::numeric_limits<std::uint32_t>::max() / width)) {
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+    return order;
+  }
+  std::vector<std::uint32_t> keys(cells.size());
+  for (std::size_t k = 0; k < keys.size(); ++k) keys[k] = static_cast<std::uint32_t>(key(static_cast<std::uint32_t>(k)));
+  std::vector<std::uint32_t> buffer(order.size());
+  std::vector<std::uint32_t> histogram(1U << 16);
+  for (const int shift : {0, 16}) {
+    std::fill(histogram.begin(), histogram.end(), 0U);
+    for (const std::uint32_t k : order) ++histogram[(keys[k] >> shift) & 0xFFFFU];
+    std::uint32_t total = 0;
+    for (std::uint32_t& bucket : histogram) total += std::exchange(bucket, total);
+    for (const std::uint32_t k : order) buffer[histogram[(keys[k] >> shift) & 0xFFFFU]++] = k;
+    order.swap(buffer);
+  }
+  return order;
 }
 
 }  // namespace
@@ -199,8 +238,46 @@ void MLMap::insert(const Point& point, double variance) {
 }
 
 void MLMap::insertScan(const Scan& scan) {
-  for (std::size_t index = 0; index < scan.size(); ++index) {
-    insert(scan.worldPoint(index), scan.variance(index));
+  // Points are grouped by cell with a stable sort before insertion: each cell then
+  // sees its points in scan order, exactly as point-by-point insertion would, but the
+  // hash grid is probed once per cell instead of once per point.
+  const std::size_t count = scan.size();
+  if (count == 0) return;
+  if (count > std::numeric_limits<std::uint32_t>::max()) throw Error("scan too large (over 2^32 points)");
+  std::vector<CellIndex> cells(count);
+  std::vector<float> heights(count);
+  std::vector<float> variances(count);
+  const auto signed_count = static_cast<std::int64_t>(count);
+  bool all_valid = true;
+#pragma omp parallel for schedule(static) reduction(&& : all_valid)
+  for (std::int64_t k = 0; k < signed_count; ++k) {
+    const auto index = static_cast<std::size_t>(k);
+    const Point world = scan.worldPoint(index);
+    const double variance = scan.variance(index);
+    const double column = std::floor(world.x() * inverse_cell_size_);
+    const double row = std::floor(world.y() * inverse_cell_size_);
+    constexpr double kLimit = 1 << 30;
+    const bool valid = std::abs(column) < kLimit && std::abs(row) < kLimit &&
+                       std::isfinite(world.z()) && variance > 0.0 && std::isfinite(variance);
+    all_valid = all_valid && valid;
+    cells[index] = valid ? CellIndex{static_cast<std::int32_t>(row), static_cast<std::int32_t>(column)}
+                         : CellIndex{};
+    heights[index] = static_cast<float>(world.z());
+    variances[index] = static_cast<float>(variance);
+  }
+  if (!all_valid) {
+    for (std::size_t index = 0; index < count; ++index) insert(scan.worldPoint(index), scan.variance(index));
+    return;  // insert() throws at the first bad point; the points before it are in.
+  }
+  const std::vector<std::uint32_t> order = sortedByCell(cells);
+  for (std::size_t begin = 0; begin < count;) {
+    const CellIndex cell = cells[order[begin]];
+    const std::size_t cell_number = findOrCreateCell(cell);
+    std::size_t end = begin;
+    for (; end < count && cells[order[end]] == cell; ++end) {
+      insertIntoCell(cell_number, heights[order[end]], heights[order[end]], variances[order[end]]);
+    }
+    begin = end;
   }
 }
 
