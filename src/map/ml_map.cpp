@@ -1,3 +1,15 @@
+// Section IV's update rules. Where the printed text is loose we read it as follows:
+// - σ is a variance; the Kalman rule is h ← (σ_m·h + σ·p_z)/(σ + σ_m),
+//   σ ← σ·σ_m/(σ + σ_m).
+// - "A block collects a measurement" when p_z lies within cell_size of the block's
+//   extent [h − d, h]: the printed |p_z − h| < cell_size ∧ |(h − d) − p_z| < cell_size
+//   cannot hold inside a vertical block deeper than two cells, yet Fig. 3 case 3 says
+//   such a point changes nothing.
+// - The 3σ test gates the innovation, |p_z − h| < 3·√(σ + σ_m): the block's own σ
+//   shrinks like σ_m / n, and against it alone ordinary range noise turns a well
+//   observed floor into shallow vertical blocks.
+// - A vertical block's h and σ are those of its highest measurement; a merge (case 4)
+//   keeps the highest block's σ unless the new point is above it.
 #include "mlmap/map/ml_map.hpp"
 
 #include <algorithm>
