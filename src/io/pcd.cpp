@@ -420,6 +420,17 @@ void readBinaryCompressed(const Header& header, const std::string& bytes, std::s
                scan);
 }
 
+// Values of a float field are rounded to float, so ascii and binary files give
+// the same coordinates.
+double parseCoordinate(const TextLines& lines, std::string_view token, bool single_precision) {
+  const double value = lines.parseDouble(token);
+  if (!single_precision) return value;
+  if (std::abs(value) > std::numeric_limits<float>::max()) {
+    lines.fail("value does not fit a float: '" + std::string(token.substr(0, 40)) + "'");
+  }
+  return static_cast<float>(value);
+}
+
 bool isNanToken(std::string_view token) {
   if (!token.empty() && (token.front() == '-' || token.front() == '+')) token.remove_prefix(1);
   return token.size() == 3 && (token[0] | 0x20) == 'n' && (token[1] | 0x20) == 'a' &&
@@ -453,7 +464,9 @@ void readAscii(const Header& header, TextLines& lines, std::size_t remaining_byt
     const std::string_view y = values[column[header.y]];
     const std::string_view z = values[column[header.z]];
     if (isNanToken(x) || isNanToken(y) || isNanToken(z)) continue;  // PCL's "no return"
-    scan.points.emplace_back(lines.parseDouble(x), lines.parseDouble(y), lines.parseDouble(z));
+    scan.points.emplace_back(parseCoordinate(lines, x, header.fields[header.x].size == 4),
+                             parseCoordinate(lines, y, header.fields[header.y].size == 4),
+                             parseCoordinate(lines, z, header.fields[header.z].size == 4));
     if (header.label) {
       const std::int64_t label = lines.parseInt(values[column[*header.label]]);
       if (label < 0 && header.fields[*header.label].type == 'U') {

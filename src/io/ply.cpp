@@ -395,6 +395,17 @@ void readBinaryVertices(BinaryBody& body, const Element& vertex, const VertexLay
 
 // ---------------------------------------------------------------- ascii body
 
+// Values of a float field are rounded to float, so ascii and binary files give
+// the same coordinates.
+double parseCoordinate(const TextLines& lines, std::string_view token, bool single_precision) {
+  const double value = lines.parseDouble(token);
+  if (!single_precision) return value;
+  if (std::abs(value) > std::numeric_limits<float>::max()) {
+    lines.fail("value does not fit a float: '" + std::string(token.substr(0, 40)) + "'");
+  }
+  return static_cast<float>(value);
+}
+
 // Skips `count` rows of a non-vertex element: one element per line.
 void skipAsciiElement(TextLines& lines, const Element& element) {
   for (std::uint64_t i = 0; i < element.count; ++i) {
@@ -439,9 +450,10 @@ void readAsciiVertices(TextLines& lines, const Element& vertex, const VertexLayo
         continue;
       }
       const std::string_view value = fields[field++];
-      if (p == layout.x) point.x() = lines.parseDouble(value);
-      else if (p == layout.y) point.y() = lines.parseDouble(value);
-      else if (p == layout.z) point.z() = lines.parseDouble(value);
+      const bool single_precision = property.type == ScalarType::Float32;
+      if (p == layout.x) point.x() = parseCoordinate(lines, value, single_precision);
+      else if (p == layout.y) point.y() = parseCoordinate(lines, value, single_precision);
+      else if (p == layout.z) point.z() = parseCoordinate(lines, value, single_precision);
       else if (layout.label && p == *layout.label) {
         label = checkedLabel(lines.parseInt(value),
                              [&] { return lines.sourceName() + ":" + std::to_string(lines.lineNumber()); });
