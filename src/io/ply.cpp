@@ -408,6 +408,7 @@ double parseCoordinate(const TextLines& lines, std::string_view token, bool sing
 
 // Skips `count` rows of a non-vertex element: one element per line.
 void skipAsciiElement(TextLines& lines, const Element& element) {
+  if (element.properties.empty()) return;  // rows without values take no line
   for (std::uint64_t i = 0; i < element.count; ++i) {
     do {
       if (!lines.next()) {
