@@ -13,7 +13,8 @@ namespace mlmap::io {
 // points are in the sensor frame and whose pose maps them to the world, in metres.
 Scan readThreeDtkScan(const std::filesystem::path& path);
 
-// The inverse, for round trips and for feeding 3DTK tools.
+// The inverse, for round trips and for feeding 3DTK tools: writes `path` and its
+// sibling .pose, each atomically. Labels and variances are not stored.
 void writeThreeDtkScan(const std::filesystem::path& path, const Scan& scan);
 
 }  // namespace mlmap::io
