@@ -31,6 +31,7 @@
 #include <optional>
 #include <string>
 
+#include "captured_cerr.hpp"
 #include "mlmap/error.hpp"
 #include "mlmap/io/atomic_file.hpp"
 #include "text_lines.hpp"
@@ -136,7 +137,10 @@ std::vector<Scan> readBinaryGraph(const std::filesystem::path& path, std::uint64
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open for reading");
   octomap::ScanGraph graph;
-  graph.readBinary(in);
+  {
+    const CapturedCerr quiet;  // ScanGraph reports progress on std::cerr
+    graph.readBinary(in);
+  }
   if (in.fail() || graph.size() != layout.size()) {
     throw Error(path.string() + ": octomap could not read the scan graph (read " +
                 std::to_string(graph.size()) + " of " + std::to_string(layout.size()) + " scans)");
@@ -271,7 +275,10 @@ void writeScanGraph(const std::filesystem::path& path, const std::vector<Scan>& 
     graph.addNode(cloud.release(), pose);  // the graph owns the cloud from here
     graph.connectPrevious();               // octomap's tools expect consecutive scans linked
   }
-  writeAtomically(path, [&](std::ostream& out) { graph.writeBinary(out); });
+  writeAtomically(path, [&](std::ostream& out) {
+    const CapturedCerr quiet;
+    graph.writeBinary(out);
+  });
 }
 
 }  // namespace mlmap::io

@@ -1,23 +1,15 @@
-// Section IV's update rules. Where the printed text is loose we read it as follows:
-// - σ is a variance; the Kalman rule is h ← (σ_m·h + σ·p_z)/(σ + σ_m),
-//   σ ← σ·σ_m/(σ + σ_m).
-// - "A block collects a measurement" when p_z lies within cell_size of the block's
-//   extent [h − d, h]: the printed |p_z − h| < cell_size ∧ |(h − d) − p_z| < cell_size
-//   cannot hold inside a vertical block deeper than two cells, yet Fig. 3 case 3 says
-//   such a point changes nothing.
-// - The 3σ test gates the innovation, |p_z − h| < 3·√(σ + σ_m): the block's own σ
-//   shrinks like σ_m / n, and against it alone ordinary range noise turns a well
-//   observed floor into shallow vertical blocks.
-// - A vertical block's h and σ are those of its highest measurement; a merge (case 4)
-//   keeps the highest block's σ unless the new point is above it.
+// The ML map's storage: cells in an open-addressing hash grid, each owning a run of
+// blocks in one arena. The update rules themselves live in block_rules.cpp.
 #include "mlmap/map/ml_map.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <utility>
 
+#include "block_rules.hpp"
 #include "mlmap/error.hpp"
 
 namespace mlmap {
@@ -34,39 +26,6 @@ std::uint64_t packCell(CellIndex cell) {
 std::size_t slotFor(CellIndex cell, std::size_t mask) {
   // Fibonacci hashing spreads neighbouring cells over the table.
   return static_cast<std::size_t>((packCell(cell) * 0x9E3779B97F4A7C15ULL) >> 20) & mask;
-}
-
-// The rules of section IV for a measurement collected by exactly one block:
-// Fig. 3 cases 2, 3 and 5.
-void updateBlock(Block& block, double z, double variance) {
-  const double height = block.height;
-  if (!block.isVertical()) {
-    // The 3σ test gates the innovation (DESIGN.md): the block's own σ shrinks like
-    // σ_m / n, so testing against it alone turns noisy floors vertical.
-    const double gate = 3.0 * std::sqrt(static_cast<double>(block.variance) + variance);
-    if (std::abs(z - height) < gate) {
-      const double sigma = block.variance;
-      block.height = static_cast<float>((variance * height + sigma * z) / (sigma + variance));
-      block.variance = static_cast<float>(sigma * variance / (sigma + variance));
-      return;
-    }
-    block.kind = BlockKind::Vertical;
-    block.depth = static_cast<float>(std::abs(z - height));
-    if (z > height) {
-      block.height = static_cast<float>(z);
-      block.variance = static_cast<float>(variance);
-    }
-    return;
-  }
-  // Vertical: h and σ are those of the highest measurement, d spans down to the lowest.
-  const double bottom = height - block.depth;
-  if (z > height) {
-    block.height = static_cast<float>(z);
-    block.depth = static_cast<float>(z - bottom);
-    block.variance = static_cast<float>(variance);
-  } else if (z < bottom) {
-    block.depth = static_cast<float>(height - z);
-  }
 }
 
 // Indices of `cells` in an order that groups equal cells, keeping scan order within
@@ -167,10 +126,9 @@ std::size_t MLMap::findOrCreateCell(CellIndex cell) {
   return last_cell_ = cells_.size() - 1;
 }
 
-void MLMap::growCell(Cell& cell) {
-  if (cell.capacity >= kMaxBlocksPerCell) throw Error("a cell holds too many blocks");
-  const std::size_t capacity =
-      std::min<std::size_t>(cell.capacity == 0 ? 1 : cell.capacity * 2U, kMaxBlocksPerCell);
+void MLMap::reserveCell(Cell& cell, std::size_t capacity) {
+  if (capacity <= cell.capacity) return;
+  if (capacity > kMaxBlocksPerCell) throw Error("a cell holds too many blocks");
   if (cell.first + cell.capacity == blocks_.size()) {
     // The cell's run is at the end of the arena: grow it in place.
     blocks_.resize(cell.first + capacity);
@@ -188,56 +146,13 @@ void MLMap::growCell(Cell& cell) {
 
 void MLMap::insertIntoCell(std::size_t cell_number, float top, float bottom, float variance) {
   Cell& cell = cells_[cell_number];
-  Block* run = blocks_.data() + cell.first;
-  const double reach = cell_size_;
-  // A block collects a measurement when it lies within cell_size of the block's
-  // extent [h − d, h] (DESIGN.md). Blocks are sorted and at least cell_size apart,
-  // so the collectors of [bottom, top] are adjacent in the run.
-  int first_hit = -1;
-  int last_hit = -1;
-  int insert_at = cell.count;
-  for (int k = 0; k < cell.count; ++k) {
-    const Block& block = run[k];
-    if (top > block.bottom() - reach && bottom < block.height + reach) {
-      if (first_hit < 0) first_hit = k;
-      last_hit = k;
-    } else if (top < block.bottom() && insert_at == cell.count) {
-      insert_at = k;
-    }
-  }
-  const bool is_point = top == bottom;
-  if (first_hit >= 0 && first_hit == last_hit && is_point) {
-    updateBlock(run[first_hit], top, variance);
-    return;
-  }
-  if (first_hit >= 0) {
-    // Fig. 3 case 4: the measurement bridges blocks (or spans more than one);
-    // all of them become one vertical block.
-    const Block& lowest = run[first_hit];
-    const Block& highest = run[last_hit];
-    Block merged;
-    merged.kind = BlockKind::Vertical;
-    const bool new_top = top > highest.height;
-    merged.height = new_top ? top : highest.height;
-    merged.variance = new_top ? variance : highest.variance;
-    merged.depth = merged.height - std::min(lowest.bottom(), bottom);
-    run[first_hit] = merged;
-    const int removed = last_hit - first_hit;
-    std::copy(run + last_hit + 1, run + cell.count, run + first_hit + 1);
-    cell.count = static_cast<std::uint16_t>(cell.count - removed);
-    block_count_ -= static_cast<std::size_t>(removed);
-    return;
-  }
-  // Fig. 3 case 1: nobody collects the measurement; a new block.
   if (cell.count == cell.capacity) {
-    growCell(cell);
-    run = blocks_.data() + cell.first;
+    reserveCell(cell, std::min<std::size_t>(cell.capacity * 2U + 1U, kMaxBlocksPerCell));
   }
-  std::copy_backward(run + insert_at, run + cell.count, run + cell.count + 1);
-  run[insert_at] = is_point ? Block{top, variance, 0.0F, 0, BlockKind::Horizontal}
-                            : Block{top, variance, top - bottom, 0, BlockKind::Vertical};
-  ++cell.count;
-  ++block_count_;
+  const int count = addMeasurement(blocks_.data() + cell.first, cell.count, top, bottom, variance,
+                                   static_cast<float>(cell_size_));
+  block_count_ += static_cast<std::size_t>(count) - cell.count;
+  cell.count = static_cast<std::uint16_t>(count);
 }
 
 void MLMap::insert(const Point& point, double variance) {
@@ -282,15 +197,72 @@ void MLMap::insertScan(const Scan& scan) {
     return;  // insert() throws at the first bad point; the points before it are in.
   }
   const std::vector<std::uint32_t> order = sortedByCell(cells);
+
+  // Runs of points in one cell. Creating cells touches the hash grid: serial. A new
+  // cell gets room for two blocks (floor and ceiling) so most runs fit in place.
+  struct Run {
+    std::size_t begin;
+    std::size_t end;
+    std::size_t cell_number;
+  };
+  std::vector<Run> runs;
   for (std::size_t begin = 0; begin < count;) {
     const CellIndex cell = cells[order[begin]];
+    std::size_t end = begin + 1;
+    while (end < count && cells[order[end]] == cell) ++end;
     const std::size_t cell_number = findOrCreateCell(cell);
-    std::size_t end = begin;
-    for (; end < count && cells[order[end]] == cell; ++end) {
-      insertIntoCell(cell_number, heights[order[end]], heights[order[end]], variances[order[end]]);
-    }
+    if (cells_[cell_number].capacity == 0) reserveCell(cells_[cell_number], 2);
+    runs.push_back(Run{begin, end, cell_number});
     begin = end;
   }
+
+  // Each run updates its own cell: in parallel, on a scratch copy written back in
+  // place when it fits; cells that outgrow their room are written back afterwards.
+  struct Outgrown {
+    std::size_t cell_number;
+    std::vector<Block> blocks;
+  };
+  std::vector<Outgrown> outgrown;
+  const auto run_count = static_cast<std::int64_t>(runs.size());
+  const auto reach = static_cast<float>(cell_size_);
+  std::int64_t added = 0;
+#pragma omp parallel reduction(+ : added)
+  {
+    std::vector<Block> scratch;
+    std::vector<Outgrown> local_outgrown;
+#pragma omp for schedule(dynamic, 512)
+    for (std::int64_t r = 0; r < run_count; ++r) {
+      const Run& run = runs[static_cast<std::size_t>(r)];
+      Cell& cell = cells_[run.cell_number];
+      const Block* stored = blocks_.data() + cell.first;
+      scratch.assign(stored, stored + cell.count);
+      scratch.resize(cell.count + (run.end - run.begin));  // a measurement adds at most one block
+      int blocks_in_cell = cell.count;
+      for (std::size_t k = run.begin; k < run.end; ++k) {
+        const std::uint32_t index = order[k];
+        blocks_in_cell = addMeasurement(scratch.data(), blocks_in_cell, heights[index], heights[index],
+                                        variances[index], reach);
+      }
+      added += blocks_in_cell - cell.count;
+      scratch.resize(static_cast<std::size_t>(blocks_in_cell));
+      if (blocks_in_cell <= cell.capacity) {
+        std::copy(scratch.begin(), scratch.end(), blocks_.begin() + cell.first);
+        cell.count = static_cast<std::uint16_t>(blocks_in_cell);
+      } else {
+        local_outgrown.push_back(Outgrown{run.cell_number, scratch});
+      }
+    }
+#pragma omp critical(mlmap_outgrown_cells)
+    outgrown.insert(outgrown.end(), std::make_move_iterator(local_outgrown.begin()),
+                    std::make_move_iterator(local_outgrown.end()));
+  }
+  for (Outgrown& grown : outgrown) {
+    Cell& cell = cells_[grown.cell_number];
+    reserveCell(cell, grown.blocks.size());
+    std::copy(grown.blocks.begin(), grown.blocks.end(), blocks_.begin() + cell.first);
+    cell.count = static_cast<std::uint16_t>(grown.blocks.size());
+  }
+  block_count_ = static_cast<std::size_t>(static_cast<std::int64_t>(block_count_) + added);
 }
 
 void MLMap::insertBlock(CellIndex cell_index, const Block& block) {
@@ -326,7 +298,7 @@ void MLMap::restoreCell(CellIndex cell_index, std::span<const Block> blocks) {
   }
   const std::size_t number = findOrCreateCell(cell_index);
   Cell& cell = cells_[number];
-  while (cell.capacity < blocks.size()) growCell(cell);
+  reserveCell(cell, blocks.size());
   std::copy(blocks.begin(), blocks.end(), blocks_.begin() + cell.first);
   cell.count = static_cast<std::uint16_t>(blocks.size());
   block_count_ += blocks.size();

@@ -47,7 +47,7 @@ class MLMap {
   std::span<const Block> blocks(CellIndex cell) const;
   std::span<Block> mutableBlocks(CellIndex cell);
 
-  // Cells in a stable order (the order they were first touched).
+  // Cells in a stable order (the order they were created), for iteration by number.
   std::size_t cellCount() const { return cells_.size(); }
   CellIndex cellAt(std::size_t cell_number) const { return cells_[cell_number].index; }
   std::span<const Block> blocksAt(std::size_t cell_number) const;
@@ -69,7 +69,7 @@ class MLMap {
   };
 
   std::size_t findOrCreateCell(CellIndex cell);
-  void growCell(Cell& cell);
+  void reserveCell(Cell& cell, std::size_t capacity);
   void insertIntoCell(std::size_t cell_number, float top, float bottom, float variance);
   void rehash(std::size_t slot_count);
 
