@@ -207,7 +207,7 @@ Map readMap(const std::filesystem::path& path) {
   if (config.with_octree) {
     const std::size_t octree_offset = in.offset();
     std::istringstream stream(std::string(in.take(octree_size, "the OcTree")));
-    const CapturedCerr octomap_says;
+    CapturedCerr octomap_says;
     std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(stream));
     auto* octree = dynamic_cast<octomap::OcTree*>(tree.get());
     if (octree == nullptr) {
