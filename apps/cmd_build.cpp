@@ -19,6 +19,7 @@ struct BuildOptions {
   std::vector<std::string> scans;
   MapConfig map;
   bool no_octree = false;
+  double range_sigma = 0.0;
 };
 
 int runBuild(const BuildOptions& options, bool quiet) {
@@ -42,6 +43,9 @@ int runBuild(const BuildOptions& options, bool quiet) {
                       std::to_string(scan_count + 1) + ")");
         }
         scan.pose = poses[scan_count].pose;
+      }
+      if (scan.variances.empty() && options.range_sigma > 0.0) {
+        scan.variances.assign(scan.size(), options.range_sigma * options.range_sigma);
       }
       map.insertScan(scan);
       ++scan_count;
@@ -85,6 +89,10 @@ void addBuildCommand(CLI::App& app, Context& context) {
   command->add_option("--max-range", options->map.max_range,
                       "Cut OcTree rays at this range, m (default: no limit)");
   command->add_flag("--no-octree", options->no_octree, "Build the block layer only");
+  command->add_option("--range-sigma", options->range_sigma,
+                      "Range noise of scans that carry no per-point variance, m "
+                      "(default: the UTM-30LX's 0.03)")
+      ->check(CLI::PositiveNumber);
   command->add_option("scans", options->scans,
                       "Scan files: .xyz .txt .pts .ply .pcd .3d (3DTK) .graph (OctoMap)")
       ->required()

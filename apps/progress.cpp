@@ -29,6 +29,7 @@ void Progress::update(std::size_t done, const std::string& detail) {
   }
   last_tenth_ = tenth;
   last_draw_ = now;
+  last_detail_ = detail;
   draw(done, detail);
 }
 
@@ -36,6 +37,8 @@ void Progress::finish(const std::string& detail) {
   if (finished_) return;
   finished_ = true;
   if (!enabled_) return;
+  // A log already has its last line when the final update reached the total.
+  if (!terminal_ && last_tenth_ == 10 && detail == last_detail_) return;
   draw(total_, detail);
   if (terminal_) std::fputc('\n', stderr);
 }

@@ -27,6 +27,7 @@ class Progress {
   bool terminal_;
   bool finished_ = false;
   int last_tenth_ = -1;
+  std::string last_detail_;
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_draw_;
 };

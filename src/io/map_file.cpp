@@ -222,6 +222,7 @@ Map readMap(const std::filesystem::path& path) {
   } else if (octree_size != 0) {
     in.fail("an OcTree follows but the flags say none");
   }
+  map.blocks().compact();
   return map;
 }
 
