@@ -9,78 +9,21 @@
 #include <lzf.h>
 
 #include <algorithm>
-#include <bit>
-#include <charconv>
-#include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <fstream>
-#include <istream>
 #include <limits>
 #include <optional>
-#include <streambuf>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "cloud_values.hpp"
+#include "file_bytes.hpp"
 #include "mlmap/error.hpp"
-#include "mlmap/io/atomic_file.hpp"
+#include "number_text.hpp"
 #include "text_lines.hpp"
 
 namespace mlmap::io {
 namespace {
-
-// ---------------------------------------------------------------- file buffer
-
-std::string readWholeFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open file");
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) throw Error(path.string() + ": cannot determine file size");
-  in.seekg(0, std::ios::beg);
-  std::string bytes(static_cast<std::size_t>(size), '\0');
-  if (!in.read(bytes.data(), size)) throw Error(path.string() + ": read failed");
-  return bytes;
-}
-
-// An istream over a buffer without copying it; tellg() gives the offset of the
-// binary body once the header lines have been consumed.
-class MemoryBuffer : public std::streambuf {
- public:
-  explicit MemoryBuffer(std::string& bytes) {
-    setg(bytes.data(), bytes.data(), bytes.data() + bytes.size());
-  }
-
- protected:
-  pos_type seekoff(off_type offset, std::ios_base::seekdir direction,
-                   std::ios_base::openmode /*which*/) override {
-    if (offset != 0 || direction != std::ios_base::cur) return pos_type(off_type(-1));
-    return pos_type(gptr() - eback());
-  }
-};
-
-// PCD binary data is little-endian in practice (PCL writes host order on x86/ARM).
-template <typename T>
-T loadLittleEndian(const char* source) {
-  T value;
-  if constexpr (std::endian::native == std::endian::little) {
-    std::memcpy(&value, source, sizeof(T));
-  } else {
-    unsigned char reversed[sizeof(T)];
-    for (std::size_t i = 0; i < sizeof(T); ++i) reversed[i] = source[sizeof(T) - 1 - i];
-    std::memcpy(&value, reversed, sizeof(T));
-  }
-  return value;
-}
-
-template <typename T>
-void storeLittleEndian(char* target, T value) {
-  std::memcpy(target, &value, sizeof(T));
-  if constexpr (std::endian::native != std::endian::little) {
-    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(target[i], target[sizeof(T) - 1 - i]);
-  }
-}
 
 // ---------------------------------------------------------------- header model
 
@@ -269,6 +212,8 @@ Header parseHeader(TextLines& lines) {
 
 // ---------------------------------------------------------------- decoding
 
+// PCD binary data is little-endian in practice (PCL writes host order on x86/ARM).
+
 double loadCoordinate(const Field& field, const char* source) {
   return field.size == 4 ? static_cast<double>(loadLittleEndian<float>(source))
                          : loadLittleEndian<double>(source);
@@ -295,16 +240,6 @@ std::int64_t loadInteger(const Field& field, const char* source) {
                  : static_cast<std::int64_t>(value);
     }
   }
-}
-
-// `where` builds the location only when the label is out of range.
-template <typename Where>
-std::int32_t checkedLabel(std::int64_t value, const Where& where) {
-  if (value < std::numeric_limits<std::int32_t>::min() ||
-      value > std::numeric_limits<std::int32_t>::max()) {
-    throw Error(where() + ": label " + std::to_string(value) + " does not fit a 32-bit integer");
-  }
-  return static_cast<std::int32_t>(value);
 }
 
 std::string byteWhere(const std::string& source, std::size_t byte) {
@@ -420,17 +355,6 @@ void readBinaryCompressed(const Header& header, const std::string& bytes, std::s
                scan);
 }
 
-// Values of a float field are rounded to float, so ascii and binary files give
-// the same coordinates.
-double parseCoordinate(const TextLines& lines, std::string_view token, bool single_precision) {
-  const double value = lines.parseDouble(token);
-  if (!single_precision) return value;
-  if (std::abs(value) > std::numeric_limits<float>::max()) {
-    lines.fail("value does not fit a float: '" + std::string(token.substr(0, 40)) + "'");
-  }
-  return static_cast<float>(value);
-}
-
 bool isNanToken(std::string_view token) {
   if (!token.empty() && (token.front() == '-' || token.front() == '+')) token.remove_prefix(1);
   return token.size() == 3 && (token[0] | 0x20) == 'n' && (token[1] | 0x20) == 'a' &&
@@ -472,8 +396,7 @@ void readAscii(const Header& header, TextLines& lines, std::size_t remaining_byt
       if (label < 0 && header.fields[*header.label].type == 'U') {
         lines.fail("negative value for unsigned label");
       }
-      scan.labels.push_back(checkedLabel(label,
-                                         [&] { return lines.sourceName() + ":" + std::to_string(lines.lineNumber()); }));
+      scan.labels.push_back(checkedLabel(label, [&] { return lineWhere(lines); }));
     }
   }
   while (lines.next()) {
@@ -484,13 +407,6 @@ void readAscii(const Header& header, TextLines& lines, std::size_t remaining_byt
 }
 
 // ---------------------------------------------------------------- writer helpers
-
-template <typename T>
-void appendNumber(std::string& out, T value) {
-  char buffer[40];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  out.append(buffer, result.ptr);
-}
 
 std::string makeHeader(const Scan& scan, bool with_labels, bool signed_labels, Encoding encoding) {
   std::string header = "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n";
@@ -516,17 +432,14 @@ std::string makeHeader(const Scan& scan, bool with_labels, bool signed_labels, E
 
 Scan readPcd(const std::filesystem::path& path) {
   const std::string source = path.string();
-  std::string bytes = readWholeFile(path);
-  MemoryBuffer buffer(bytes);
-  std::istream stream(&buffer);
-  TextLines lines(stream, source);
+  InMemoryFile file(path);
+  const std::string& bytes = file.bytes();
+  TextLines lines(file.stream(), source);
   const Header header = parseHeader(lines);
 
   Scan scan;
   scan.pose = header.viewpoint;
-  // A header ending without '\n' leaves eofbit set, which would make tellg() fail.
-  stream.clear();
-  const auto body_start = static_cast<std::size_t>(stream.tellg());
+  const std::size_t body_start = file.offset();
   switch (header.encoding) {
     case Encoding::Ascii: readAscii(header, lines, bytes.size() - body_start, scan); break;
     case Encoding::Binary: readBinary(header, bytes, body_start, source, scan); break;
@@ -536,11 +449,8 @@ Scan readPcd(const std::filesystem::path& path) {
 }
 
 void writePcd(const std::filesystem::path& path, const Scan& scan, PcdEncoding encoding) {
+  requireLabelPerPoint(path, scan);
   const bool with_labels = !scan.labels.empty();
-  if (with_labels && scan.labels.size() != scan.points.size()) {
-    throw Error(path.string() + ": scan has " + std::to_string(scan.points.size()) + " points but " +
-                std::to_string(scan.labels.size()) + " labels");
-  }
   // Unsigned labels as PCL's PointXYZL has them, unless a label is negative.
   bool signed_labels = false;
   for (const std::int32_t label : scan.labels) signed_labels |= label < 0;
@@ -606,9 +516,7 @@ void writePcd(const std::filesystem::path& path, const Scan& scan, PcdEncoding e
     out.append(sizes, 8);
     out.append(packed.data(), packed_bytes);
   }
-  writeAtomically(path, [&](std::ostream& stream) {
-    stream.write(out.data(), static_cast<std::streamsize>(out.size()));
-  });
+  writeWholeFile(path, out);
 }
 
 }  // namespace mlmap::io

@@ -5,78 +5,20 @@
 #include "mlmap/io/ply.hpp"
 
 #include <algorithm>
-#include <bit>
-#include <charconv>
-#include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <fstream>
-#include <istream>
-#include <limits>
 #include <optional>
-#include <streambuf>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "cloud_values.hpp"
+#include "file_bytes.hpp"
 #include "mlmap/error.hpp"
-#include "mlmap/io/atomic_file.hpp"
+#include "number_text.hpp"
 #include "text_lines.hpp"
 
 namespace mlmap::io {
 namespace {
-
-// ---------------------------------------------------------------- file buffer
-
-std::string readWholeFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open file");
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) throw Error(path.string() + ": cannot determine file size");
-  in.seekg(0, std::ios::beg);
-  std::string bytes(static_cast<std::size_t>(size), '\0');
-  if (!in.read(bytes.data(), size)) throw Error(path.string() + ": read failed");
-  return bytes;
-}
-
-// An istream over a buffer without copying it; tellg() gives the offset of the
-// binary body once the header lines have been consumed.
-class MemoryBuffer : public std::streambuf {
- public:
-  explicit MemoryBuffer(std::string& bytes) {
-    setg(bytes.data(), bytes.data(), bytes.data() + bytes.size());
-  }
-
- protected:
-  pos_type seekoff(off_type offset, std::ios_base::seekdir direction,
-                   std::ios_base::openmode /*which*/) override {
-    if (offset != 0 || direction != std::ios_base::cur) return pos_type(off_type(-1));
-    return pos_type(gptr() - eback());
-  }
-};
-
-// Little-endian loads and stores that work on any host and any alignment.
-template <typename T>
-T loadLittleEndian(const char* source) {
-  T value;
-  if constexpr (std::endian::native == std::endian::little) {
-    std::memcpy(&value, source, sizeof(T));
-  } else {
-    unsigned char reversed[sizeof(T)];
-    for (std::size_t i = 0; i < sizeof(T); ++i) reversed[i] = source[sizeof(T) - 1 - i];
-    std::memcpy(&value, reversed, sizeof(T));
-  }
-  return value;
-}
-
-template <typename T>
-void storeLittleEndian(char* target, T value) {
-  std::memcpy(target, &value, sizeof(T));
-  if constexpr (std::endian::native != std::endian::little) {
-    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(target[i], target[sizeof(T) - 1 - i]);
-  }
-}
 
 // ---------------------------------------------------------------- header model
 
@@ -112,21 +54,7 @@ bool isInteger(ScalarType type) {
   return type != ScalarType::Float32 && type != ScalarType::Float64;
 }
 
-// Reads one scalar of `type` at `source` (bounds already checked), widened.
-double loadAsDouble(ScalarType type, const char* source) {
-  switch (type) {
-    case ScalarType::Int8: return static_cast<std::int8_t>(*source);
-    case ScalarType::Uint8: return static_cast<std::uint8_t>(*source);
-    case ScalarType::Int16: return loadLittleEndian<std::int16_t>(source);
-    case ScalarType::Uint16: return loadLittleEndian<std::uint16_t>(source);
-    case ScalarType::Int32: return loadLittleEndian<std::int32_t>(source);
-    case ScalarType::Uint32: return loadLittleEndian<std::uint32_t>(source);
-    case ScalarType::Float32: return loadLittleEndian<float>(source);
-    case ScalarType::Float64: return loadLittleEndian<double>(source);
-  }
-  return 0.0;
-}
-
+// Reads one integer scalar of `type` at `source` (bounds already checked), widened.
 std::int64_t loadAsInteger(ScalarType type, const char* source) {
   switch (type) {
     case ScalarType::Int8: return static_cast<std::int8_t>(*source);
@@ -136,6 +64,15 @@ std::int64_t loadAsInteger(ScalarType type, const char* source) {
     case ScalarType::Int32: return loadLittleEndian<std::int32_t>(source);
     case ScalarType::Uint32: return loadLittleEndian<std::uint32_t>(source);
     default: return 0;  // only called for integer types
+  }
+}
+
+// Any scalar, widened: every integer type fits a double exactly.
+double loadAsDouble(ScalarType type, const char* source) {
+  switch (type) {
+    case ScalarType::Float32: return loadLittleEndian<float>(source);
+    case ScalarType::Float64: return loadLittleEndian<double>(source);
+    default: return static_cast<double>(loadAsInteger(type, source));
   }
 }
 
@@ -270,16 +207,6 @@ VertexLayout findVertexLayout(const Element& vertex, const std::string& source) 
   return layout;
 }
 
-// `where` builds the location only when the label is out of range.
-template <typename Where>
-std::int32_t checkedLabel(std::int64_t value, const Where& where) {
-  if (value < std::numeric_limits<std::int32_t>::min() ||
-      value > std::numeric_limits<std::int32_t>::max()) {
-    throw Error(where() + ": label " + std::to_string(value) + " does not fit a 32-bit integer");
-  }
-  return static_cast<std::int32_t>(value);
-}
-
 // ---------------------------------------------------------------- binary body
 
 class BinaryBody {
@@ -395,17 +322,6 @@ void readBinaryVertices(BinaryBody& body, const Element& vertex, const VertexLay
 
 // ---------------------------------------------------------------- ascii body
 
-// Values of a float field are rounded to float, so ascii and binary files give
-// the same coordinates.
-double parseCoordinate(const TextLines& lines, std::string_view token, bool single_precision) {
-  const double value = lines.parseDouble(token);
-  if (!single_precision) return value;
-  if (std::abs(value) > std::numeric_limits<float>::max()) {
-    lines.fail("value does not fit a float: '" + std::string(token.substr(0, 40)) + "'");
-  }
-  return static_cast<float>(value);
-}
-
 // Skips `count` rows of a non-vertex element: one element per line.
 void skipAsciiElement(TextLines& lines, const Element& element) {
   if (element.properties.empty()) return;  // rows without values take no line
@@ -456,8 +372,7 @@ void readAsciiVertices(TextLines& lines, const Element& vertex, const VertexLayo
       else if (p == layout.y) point.y() = parseCoordinate(lines, value, single_precision);
       else if (p == layout.z) point.z() = parseCoordinate(lines, value, single_precision);
       else if (layout.label && p == *layout.label) {
-        label = checkedLabel(lines.parseInt(value),
-                             [&] { return lines.sourceName() + ":" + std::to_string(lines.lineNumber()); });
+        label = checkedLabel(lines.parseInt(value), [&] { return lineWhere(lines); });
       }
     }
     if (field != fields.size()) {
@@ -469,28 +384,13 @@ void readAsciiVertices(TextLines& lines, const Element& vertex, const VertexLayo
   }
 }
 
-// ---------------------------------------------------------------- writer helpers
-
-void appendFloat(std::string& out, float value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  out.append(buffer, result.ptr);
-}
-
-void appendInt(std::string& out, std::int32_t value) {
-  char buffer[16];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  out.append(buffer, result.ptr);
-}
-
 }  // namespace
 
 Scan readPly(const std::filesystem::path& path) {
   const std::string source = path.string();
-  std::string bytes = readWholeFile(path);
-  MemoryBuffer buffer(bytes);
-  std::istream stream(&buffer);
-  TextLines lines(stream, source);
+  InMemoryFile file(path);
+  const std::string& bytes = file.bytes();
+  TextLines lines(file.stream(), source);
   const Header header = parseHeader(lines);
 
   const Element* vertex = nullptr;
@@ -503,9 +403,7 @@ Scan readPly(const std::filesystem::path& path) {
   if (vertex == nullptr) lines.fail("header has no 'element vertex'");
   const VertexLayout layout = findVertexLayout(*vertex, source);
 
-  // A header ending without '\n' leaves eofbit set, which would make tellg() fail.
-  stream.clear();
-  const auto body_start = static_cast<std::size_t>(stream.tellg());
+  const std::size_t body_start = file.offset();
   Scan scan;
   if (header.format == Format::Ascii) {
     for (const Element& element : header.elements) {
@@ -526,11 +424,8 @@ Scan readPly(const std::filesystem::path& path) {
 }
 
 void writePly(const std::filesystem::path& path, const Scan& scan, PlyEncoding encoding) {
+  requireLabelPerPoint(path, scan);
   const bool with_labels = !scan.labels.empty();
-  if (with_labels && scan.labels.size() != scan.points.size()) {
-    throw Error(path.string() + ": scan has " + std::to_string(scan.points.size()) + " points but " +
-                std::to_string(scan.labels.size()) + " labels");
-  }
   std::string out;
   out += "ply\nformat ";
   out += encoding == PlyEncoding::Ascii ? "ascii" : "binary_little_endian";
@@ -543,14 +438,14 @@ void writePly(const std::filesystem::path& path, const Scan& scan, PlyEncoding e
     out.reserve(out.size() + scan.size() * (with_labels ? 48 : 40));
     for (std::size_t i = 0; i < scan.size(); ++i) {
       const Point& point = scan.points[i];
-      appendFloat(out, static_cast<float>(point.x()));
+      appendNumber(out, static_cast<float>(point.x()));
       out += ' ';
-      appendFloat(out, static_cast<float>(point.y()));
+      appendNumber(out, static_cast<float>(point.y()));
       out += ' ';
-      appendFloat(out, static_cast<float>(point.z()));
+      appendNumber(out, static_cast<float>(point.z()));
       if (with_labels) {
         out += ' ';
-        appendInt(out, scan.labels[i]);
+        appendNumber(out, scan.labels[i]);
       }
       out += '\n';
     }
@@ -567,9 +462,7 @@ void writePly(const std::filesystem::path& path, const Scan& scan, PlyEncoding e
       if (with_labels) storeLittleEndian(row + 12, scan.labels[i]);
     }
   }
-  writeAtomically(path, [&](std::ostream& stream) {
-    stream.write(out.data(), static_cast<std::streamsize>(out.size()));
-  });
+  writeWholeFile(path, out);
 }
 
 }  // namespace mlmap::io

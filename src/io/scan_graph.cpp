@@ -32,6 +32,7 @@
 #include <string>
 
 #include "captured_cerr.hpp"
+#include "file_bytes.hpp"
 #include "mlmap/error.hpp"
 #include "mlmap/io/atomic_file.hpp"
 #include "text_lines.hpp"
@@ -234,10 +235,8 @@ bool looksLikeAscii(const std::filesystem::path& path) {
 }  // namespace
 
 std::vector<Scan> readScanGraph(const std::filesystem::path& path) {
+  requireRegularFile(path);
   std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
-  if (!std::filesystem::is_regular_file(path, error))
-    throw Error(path.string() + ": not a regular file");
   const std::uint64_t file_size = std::filesystem::file_size(path, error);
   if (error) throw Error(path.string() + ": cannot read size (" + error.message() + ")");
   if (looksLikeAscii(path)) return readAsciiGraph(path);

@@ -24,13 +24,13 @@
 #include "mlmap/io/threedtk.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <string>
 
+#include "file_bytes.hpp"
 #include "mlmap/error.hpp"
-#include "mlmap/io/atomic_file.hpp"
+#include "number_text.hpp"
 #include "text_lines.hpp"
 
 namespace mlmap::io {
@@ -48,17 +48,6 @@ Eigen::Matrix3d axisChange() {
        0, 1, 0;
   // clang-format on
   return a;
-}
-
-std::ifstream openForReading(const std::filesystem::path& path) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
-  if (!std::filesystem::is_regular_file(path, error)) {
-    throw Error(path.string() + ": not a regular file");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open for reading");
-  return in;
 }
 
 // The old "uos" header, e.g. "360 x 225" (scan lines x points per line).
@@ -114,12 +103,6 @@ Eigen::Vector3d eulerXyz(const Eigen::Matrix3d& r) {
   const double sx = std::sin(theta_x), cx = std::cos(theta_x);
   const double theta_z = std::atan2(cx * r(1, 0) + sx * r(2, 0), cx * r(1, 1) + sx * r(2, 1));
   return {theta_x, theta_y, theta_z};
-}
-
-void appendNumber(std::string& buffer, double value) {
-  char text[32];
-  const auto result = std::to_chars(text, text + sizeof(text), value);  // shortest round trip
-  buffer.append(text, result.ptr);
 }
 
 void appendTriple(std::string& buffer, const Eigen::Vector3d& values) {
@@ -184,12 +167,8 @@ void writeThreeDtkScan(const std::filesystem::path& path, const Scan& scan) {
   std::filesystem::path pose_path = path;
   pose_path.replace_extension(".pose");
   // The scan first: a .pose without its .3d is never read, a .3d without a .pose is refused.
-  writeAtomically(path, [&](std::ostream& out) {
-    out.write(points_text.data(), static_cast<std::streamsize>(points_text.size()));
-  });
-  writeAtomically(pose_path, [&](std::ostream& out) {
-    out.write(pose_text.data(), static_cast<std::streamsize>(pose_text.size()));
-  });
+  writeWholeFile(path, points_text);
+  writeWholeFile(pose_path, pose_text);
 }
 
 }  // namespace mlmap::io

@@ -4,13 +4,13 @@
 #include "mlmap/io/tum_poses.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <string>
 
+#include "file_bytes.hpp"
 #include "mlmap/error.hpp"
-#include "mlmap/io/atomic_file.hpp"
+#include "number_text.hpp"
 #include "text_lines.hpp"
 
 namespace mlmap::io {
@@ -18,12 +18,6 @@ namespace {
 
 constexpr std::size_t kFieldsPerPose = 8;
 constexpr double kMinQuaternionNorm = 1e-6;
-
-void appendNumber(std::string& buffer, double value) {
-  char text[32];
-  const auto result = std::to_chars(text, text + sizeof(text), value);  // shortest round trip
-  buffer.append(text, result.ptr);
-}
 
 }  // namespace
 
@@ -86,9 +80,7 @@ void writeTumPoses(const std::filesystem::path& path, const std::vector<StampedP
     }
     text.push_back('\n');
   }
-  writeAtomically(path, [&](std::ostream& out) {
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  });
+  writeWholeFile(path, text);
 }
 
 }  // namespace mlmap::io

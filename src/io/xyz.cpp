@@ -25,6 +25,7 @@
 #include <string>
 #include <string_view>
 
+#include "file_bytes.hpp"
 #include "mlmap/error.hpp"
 #include "mlmap/io/atomic_file.hpp"
 
@@ -35,14 +36,9 @@ bool isSeparator(char c) {
   return c == ' ' || c == '\t' || c == ',' || c == '\v' || c == '\f' || c == '\r';
 }
 
-std::string readWholeFile(const std::filesystem::path& path) {
+std::string readText(const std::filesystem::path& path) {
+  std::ifstream in = openForReading(path);
   std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
-  if (!std::filesystem::is_regular_file(path, error)) {
-    throw Error(path.string() + ": not a regular file");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open for reading");
   const auto size = std::filesystem::file_size(path, error);
   if (error) throw Error(path.string() + ": cannot read size (" + error.message() + ")");
   std::string data(static_cast<std::size_t>(size), '\0');
@@ -164,7 +160,7 @@ char* formatCoordinate(char* out, double value) {
 
 Scan readXyz(const std::filesystem::path& path) {
   const std::string source = path.string();
-  const std::string data = readWholeFile(path);
+  const std::string data = readText(path);
 
   Scan scan;
   scan.points.reserve(data.size() / 32);

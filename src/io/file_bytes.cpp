@@ -1,0 +1,44 @@
+#include "file_bytes.hpp"
+
+#include "mlmap/error.hpp"
+#include "mlmap/io/atomic_file.hpp"
+
+namespace mlmap::io {
+
+std::string readWholeFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot open file");
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw Error(path.string() + ": cannot determine file size");
+  in.seekg(0, std::ios::beg);
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  if (!in.read(bytes.data(), size)) throw Error(path.string() + ": read failed");
+  return bytes;
+}
+
+void requireRegularFile(const std::filesystem::path& path) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
+  if (!std::filesystem::is_regular_file(path, error)) {
+    throw Error(path.string() + ": not a regular file");
+  }
+}
+
+std::ifstream openForReading(const std::filesystem::path& path) {
+  requireRegularFile(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot open for reading");
+  return in;
+}
+
+void writeWholeFile(const std::filesystem::path& path, const std::string& bytes) {
+  writeAtomically(path, [&](std::ostream& out) {
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  });
+}
+
+InMemoryFile::InMemoryFile(const std::filesystem::path& path)
+    : bytes_(readWholeFile(path)), buffer_(bytes_), stream_(&buffer_) {}
+
+}  // namespace mlmap::io

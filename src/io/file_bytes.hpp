@@ -1,0 +1,78 @@
+// Internal helper for the scan formats: whole files in and out as bytes, an
+// istream over bytes already in memory, and little-endian loads and stores that
+// work on any host and any alignment (binary rows are packed, so unaligned).
+#pragma once
+
+#include <bit>
+#include <cstddef>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <istream>
+#include <streambuf>
+#include <string>
+#include <utility>
+
+namespace mlmap::io {
+
+// The file's bytes; mlmap::Error "path: cannot open file" and the like.
+std::string readWholeFile(const std::filesystem::path& path);
+
+// Throws mlmap::Error "path: no such file" or "path: not a regular file".
+void requireRegularFile(const std::filesystem::path& path);
+
+// requireRegularFile, then a binary stream; "path: cannot open for reading".
+std::ifstream openForReading(const std::filesystem::path& path);
+
+// writeAtomically with `bytes` as the whole content.
+void writeWholeFile(const std::filesystem::path& path, const std::string& bytes);
+
+// A file read whole, with an istream over its bytes (no copy) for a text header
+// followed by a binary body.
+class InMemoryFile {
+ public:
+  explicit InMemoryFile(const std::filesystem::path& path);
+  InMemoryFile(const InMemoryFile&) = delete;
+  InMemoryFile& operator=(const InMemoryFile&) = delete;
+
+  const std::string& bytes() const { return bytes_; }
+  std::istream& stream() { return stream_; }
+  // Bytes the stream has consumed: where the body starts once the header is read.
+  std::size_t offset() const { return buffer_.offset(); }
+
+ private:
+  class Buffer : public std::streambuf {
+   public:
+    explicit Buffer(std::string& bytes) {
+      setg(bytes.data(), bytes.data(), bytes.data() + bytes.size());
+    }
+    std::size_t offset() const { return static_cast<std::size_t>(gptr() - eback()); }
+  };
+
+  std::string bytes_;
+  Buffer buffer_;
+  std::istream stream_;
+};
+
+template <typename T>
+T loadLittleEndian(const char* source) {
+  T value;
+  if constexpr (std::endian::native == std::endian::little) {
+    std::memcpy(&value, source, sizeof(T));
+  } else {
+    unsigned char reversed[sizeof(T)];
+    for (std::size_t i = 0; i < sizeof(T); ++i) reversed[i] = source[sizeof(T) - 1 - i];
+    std::memcpy(&value, reversed, sizeof(T));
+  }
+  return value;
+}
+
+template <typename T>
+void storeLittleEndian(char* target, T value) {
+  std::memcpy(target, &value, sizeof(T));
+  if constexpr (std::endian::native != std::endian::little) {
+    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(target[i], target[sizeof(T) - 1 - i]);
+  }
+}
+
+}  // namespace mlmap::io
