@@ -1,11 +1,20 @@
-// Shared test helpers: temporary directories, file fixtures, the shared data folder.
+// Shared test helpers: temporary directories, file fixtures, the shared data folder,
+// random scans, and the messages of the errors readers throw.
 #pragma once
 
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <random>
 #include <string>
+
+#include "mlmap/error.hpp"
+#include "mlmap/scan.hpp"
 
 namespace mlmap::test {
 
@@ -53,6 +62,109 @@ inline std::optional<std::filesystem::path> sharedDataDir() {
 // Debian's liboctomap-dev example data (every machine with the package has it).
 inline std::filesystem::path octomapExampleDir() {
   return "/usr/share/doc/liboctomap-dev/examples/data";
+}
+
+inline bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// The message of the mlmap::Error that `call` throws; the test case fails (naming
+// `context`) when it throws none.
+template <typename Call>
+std::string errorOf(Call&& call, const std::string& context = "") {
+  try {
+    call();
+  } catch (const mlmap::Error& error) {
+    return error.what();
+  }
+  FAIL("no mlmap::Error" << context);
+  return {};
+}
+
+// Writes `bytes` to `path`, then the message of the mlmap::Error that `read(path)`
+// throws; the test case fails when it throws none.
+template <typename Read>
+std::string errorReading(const std::filesystem::path& path, const std::string& bytes,
+                         Read&& read) {
+  writeText(path, bytes);
+  return errorOf([&] { read(path); }, " reading " + path.filename().string() + " (" +
+                                          std::to_string(bytes.size()) + " bytes)");
+}
+
+// Little-endian byte builder for hand-made binary bodies (the tests run on
+// little-endian hosts, as the readers' users do).
+template <typename T>
+void put(std::string& bytes, T value) {
+  char raw[sizeof(T)];
+  std::memcpy(raw, &value, sizeof(T));
+  bytes.append(raw, sizeof(T));
+}
+
+struct LabelRange {
+  std::int32_t min = 0, max = 0;
+};
+
+// `count` points uniform in [-extent, extent)³ from `seed`, each followed by a
+// label from `labels` when given; identity pose.
+inline Scan randomScan(std::size_t count, unsigned seed, double extent,
+                       std::optional<LabelRange> labels = std::nullopt) {
+  std::mt19937 generator(seed);
+  std::uniform_real_distribution<double> coordinate(-extent, extent);
+  std::uniform_int_distribution<std::int32_t> label(labels ? labels->min : 0,
+                                                    labels ? labels->max : 0);
+  Scan scan;
+  for (std::size_t i = 0; i < count; ++i) {
+    scan.points.emplace_back(coordinate(generator), coordinate(generator), coordinate(generator));
+    if (labels) scan.labels.push_back(label(generator));
+  }
+  return scan;
+}
+
+// Largest |read - written| / |written| over the points, which must match in number.
+inline double maxRelativeError(const Scan& read, const Scan& written) {
+  REQUIRE(read.size() == written.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    worst = std::max(worst, (read.points[i] - written.points[i]).norm() / written.points[i].norm());
+  }
+  return worst;
+}
+
+// Same number of points, each within `tolerance` (m) of its counterpart.
+inline void checkSamePoints(const Scan& a, const Scan& b, double tolerance) {
+  REQUIRE(a.size() == b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    CAPTURE(i);
+    CHECK((a.points[i] - b.points[i]).norm() < tolerance);
+  }
+}
+
+// Reads 300 damaged copies of `good` from `path` with `read` (every third one
+// truncated, the others with four random bytes overwritten, from `seed`); every
+// copy that reads must have no labels or one per point. Returns how many copies
+// threw mlmap::Error.
+template <typename Read>
+int readCorruptedCopies(const std::string& good, const std::filesystem::path& path,
+                        unsigned seed, Read&& read) {
+  std::mt19937 generator(seed);
+  int failures = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::string bytes = good;
+    std::uniform_int_distribution<std::size_t> position(0, bytes.size() - 1);
+    if (trial % 3 == 0) {
+      bytes.resize(position(generator));
+    } else {
+      for (int k = 0; k < 4; ++k) bytes[position(generator)] = static_cast<char>(generator());
+    }
+    writeText(path, bytes);
+    try {
+      const Scan scan = read(path);
+      CHECK((scan.labels.empty() || scan.labels.size() == scan.points.size()));
+    } catch (const mlmap::Error&) {
+      ++failures;
+    }
+  }
+  return failures;
 }
 
 }  // namespace mlmap::test

@@ -7,8 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <random>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -22,31 +21,23 @@ using mlmap::Scan;
 using mlmap::io::PcdEncoding;
 using mlmap::io::readPcd;
 using mlmap::io::writePcd;
+using mlmap::test::contains;
+using mlmap::test::errorOf;
+using mlmap::test::LabelRange;
+using mlmap::test::put;
 using mlmap::test::TempDir;
 using mlmap::test::writeText;
 
 namespace {
 
 Scan randomScan(std::size_t count, bool with_labels, bool negative_labels, unsigned seed) {
-  std::mt19937 generator(seed);
-  std::uniform_real_distribution<double> coordinate(-50.0, 50.0);
-  std::uniform_int_distribution<std::int32_t> label(negative_labels ? -1000 : 0, 2000000);
-  Scan scan;
-  for (std::size_t i = 0; i < count; ++i) {
-    scan.points.emplace_back(coordinate(generator), coordinate(generator), coordinate(generator));
-    if (with_labels) scan.labels.push_back(label(generator));
-  }
+  Scan scan = mlmap::test::randomScan(
+      count, seed, 50.0,
+      with_labels ? std::optional(LabelRange{negative_labels ? -1000 : 0, 2000000}) : std::nullopt);
   scan.pose = Pose::Identity();
   scan.pose.translate(Eigen::Vector3d(1.5, -2.25, 0.75));
   scan.pose.rotate(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
   return scan;
-}
-
-template <typename T>
-void put(std::string& bytes, T value) {
-  char raw[sizeof(T)];
-  std::memcpy(raw, &value, sizeof(T));
-  bytes.append(raw, sizeof(T));
 }
 
 // A valid LZF stream made of literal runs only (control byte = run length - 1),
@@ -59,20 +50,6 @@ std::string lzfLiterals(const std::string& data) {
     out.append(data, start, length);
   }
   return out;
-}
-
-template <typename F>
-std::string errorOf(F&& call) {
-  try {
-    call();
-  } catch (const mlmap::Error& error) {
-    return error.what();
-  }
-  return "<no mlmap::Error>";
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
 }
 
 }  // namespace
@@ -88,14 +65,8 @@ TEST_CASE("pcd: round trip of every encoding, with and without labels") {
       const auto path = dir / "cloud.pcd";
       writePcd(path, written, encoding);
       const Scan read = readPcd(path);
-      REQUIRE(read.size() == written.size());
       // Written as float: each coordinate rounded to 24 bits (relative error 2^-24).
-      double worst_relative_error = 0.0;
-      for (std::size_t i = 0; i < read.size(); ++i) {
-        worst_relative_error = std::max(worst_relative_error, (read.points[i] - written.points[i]).norm() /
-                                                                  written.points[i].norm());
-      }
-      CHECK(worst_relative_error < 1e-7);
+      CHECK(mlmap::test::maxRelativeError(read, written) < 1e-7);
       CHECK(read.labels == written.labels);
       CHECK(read.pose.isApprox(written.pose, 1e-12));
     }
@@ -284,8 +255,7 @@ TEST_CASE("pcd: bad headers fail naming file and line") {
   TempDir dir;
   const auto path = dir / "bad.pcd";
   const auto failure = [&](const std::string& text) {
-    writeText(path, text);
-    return errorOf([&] { readPcd(path); });
+    return mlmap::test::errorReading(path, text, readPcd);
   };
   std::string message = failure("ply\nformat ascii 1.0\n");
   CHECK_MESSAGE(contains(message, "bad.pcd:1:"), message);
@@ -338,8 +308,7 @@ TEST_CASE("pcd: bad ascii bodies fail naming file and line") {
   const std::string header =
       "FIELDS x y z label\nSIZE 4 4 4 4\nTYPE F F F U\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n";
   const auto failure = [&](const std::string& body) {
-    writeText(path, header + body);
-    return errorOf([&] { readPcd(path); });
+    return mlmap::test::errorReading(path, header + body, readPcd);
   };
   std::string message = failure("1 2 3 0\n4 inf 6 0\n7 8 9 0\n");
   CHECK_MESSAGE(contains(message, "bad.pcd:9:"), message);
@@ -481,24 +450,8 @@ TEST_CASE("pcd: random corruption of binary and compressed files never crashes")
   for (const PcdEncoding encoding : {PcdEncoding::Binary, PcdEncoding::BinaryCompressed}) {
     writePcd(dir / "good.pcd", scan, encoding);
     const std::string good = mlmap::test::readText(dir / "good.pcd");
-    std::mt19937 generator(17);
-    int failures = 0;
-    for (int trial = 0; trial < 300; ++trial) {
-      std::string bytes = good;
-      std::uniform_int_distribution<std::size_t> position(0, bytes.size() - 1);
-      if (trial % 3 == 0) {
-        bytes.resize(position(generator));
-      } else {
-        for (int k = 0; k < 4; ++k) bytes[position(generator)] = static_cast<char>(generator());
-      }
-      writeText(dir / "bad.pcd", bytes);
-      try {
-        const Scan read = readPcd(dir / "bad.pcd");
-        CHECK((read.labels.empty() || read.labels.size() == read.points.size()));
-      } catch (const mlmap::Error&) {
-        ++failures;
-      }
-    }
+    const int failures = mlmap::test::readCorruptedCopies(
+        good, dir / "bad.pcd", 17, [](const auto& path) { return readPcd(path); });
     CHECK(failures > 0);
   }
 }

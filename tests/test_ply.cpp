@@ -2,12 +2,10 @@
 // layouts other tools write, and hostile input that must fail with file and line/byte.
 #include <doctest/doctest.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <random>
+#include <optional>
 #include <string>
 
 #include "helpers.hpp"
@@ -19,43 +17,18 @@ using mlmap::Scan;
 using mlmap::io::PlyEncoding;
 using mlmap::io::readPly;
 using mlmap::io::writePly;
+using mlmap::test::contains;
+using mlmap::test::errorOf;
+using mlmap::test::LabelRange;
+using mlmap::test::put;
 using mlmap::test::TempDir;
 using mlmap::test::writeText;
 
 namespace {
 
 Scan randomScan(std::size_t count, bool with_labels, unsigned seed) {
-  std::mt19937 generator(seed);
-  std::uniform_real_distribution<double> coordinate(-50.0, 50.0);
-  std::uniform_int_distribution<std::int32_t> label(-5, 100000);
-  Scan scan;
-  for (std::size_t i = 0; i < count; ++i) {
-    scan.points.emplace_back(coordinate(generator), coordinate(generator), coordinate(generator));
-    if (with_labels) scan.labels.push_back(label(generator));
-  }
-  return scan;
-}
-
-// Little-endian byte builder for hand-made binary bodies.
-template <typename T>
-void put(std::string& bytes, T value) {
-  char raw[sizeof(T)];
-  std::memcpy(raw, &value, sizeof(T));
-  bytes.append(raw, sizeof(T));
-}
-
-template <typename F>
-std::string errorOf(F&& call) {
-  try {
-    call();
-  } catch (const mlmap::Error& error) {
-    return error.what();
-  }
-  return "<no mlmap::Error>";
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
+  const auto labels = with_labels ? std::optional(LabelRange{-5, 100000}) : std::nullopt;
+  return mlmap::test::randomScan(count, seed, 50.0, labels);
 }
 
 }  // namespace
@@ -70,14 +43,8 @@ TEST_CASE("ply: round trip of both encodings, with and without labels") {
       const auto path = dir / "cloud.ply";
       writePly(path, written, encoding);
       const Scan read = readPly(path);
-      REQUIRE(read.size() == written.size());
       // Written as float: each coordinate rounded to 24 bits (relative error 2^-24).
-      double worst_relative_error = 0.0;
-      for (std::size_t i = 0; i < read.size(); ++i) {
-        worst_relative_error = std::max(worst_relative_error, (read.points[i] - written.points[i]).norm() /
-                                                                  written.points[i].norm());
-      }
-      CHECK(worst_relative_error < 1e-7);
+      CHECK(mlmap::test::maxRelativeError(read, written) < 1e-7);
       CHECK(read.labels == written.labels);
     }
   }
@@ -214,8 +181,7 @@ TEST_CASE("ply: bad headers fail naming file and line") {
   TempDir dir;
   const auto path = dir / "bad.ply";
   const auto failure = [&](const std::string& text) {
-    writeText(path, text);
-    return errorOf([&] { readPly(path); });
+    return mlmap::test::errorReading(path, text, readPly);
   };
   const std::string vertex_xyz =
       "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n";
@@ -262,8 +228,7 @@ TEST_CASE("ply: bad ascii bodies fail naming file and line") {
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
       "property float z\nproperty int label\nend_header\n";  // 8 lines
   const auto failure = [&](const std::string& body) {
-    writeText(path, header + body);
-    return errorOf([&] { readPly(path); });
+    return mlmap::test::errorReading(path, header + body, readPly);
   };
   std::string message = failure("1 2 3 0\n4 nan 6 0\n7 8 9 0\n");
   CHECK_MESSAGE(contains(message, "bad.ply:10:"), message);
@@ -376,23 +341,7 @@ TEST_CASE("ply: random corruption of a binary file never crashes") {
   Scan scan = randomScan(50, true, 3);
   writePly(dir / "good.ply", scan);
   const std::string good = mlmap::test::readText(dir / "good.ply");
-  std::mt19937 generator(11);
-  int failures = 0;
-  for (int trial = 0; trial < 300; ++trial) {
-    std::string bytes = good;
-    std::uniform_int_distribution<std::size_t> position(0, bytes.size() - 1);
-    if (trial % 3 == 0) {
-      bytes.resize(position(generator));
-    } else {
-      for (int k = 0; k < 4; ++k) bytes[position(generator)] = static_cast<char>(generator());
-    }
-    writeText(dir / "bad.ply", bytes);
-    try {
-      const Scan read = readPly(dir / "bad.ply");
-      CHECK((read.labels.empty() || read.labels.size() == read.points.size()));
-    } catch (const mlmap::Error&) {
-      ++failures;
-    }
-  }
+  const int failures = mlmap::test::readCorruptedCopies(
+      good, dir / "bad.ply", 11, [](const auto& path) { return readPly(path); });
   CHECK(failures > 0);
 }

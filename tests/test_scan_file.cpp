@@ -11,6 +11,7 @@ using mlmap::Point;
 using mlmap::Scan;
 using mlmap::io::readScans;
 using mlmap::io::writeScan;
+using mlmap::test::checkSamePoints;
 using mlmap::test::readText;
 using mlmap::test::TempDir;
 using mlmap::test::writeText;
@@ -23,14 +24,6 @@ Scan smallScan() {
   scan.pose.translation() = Eigen::Vector3d(1.0, 2.0, 0.0);
   scan.pose.linear() = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   return scan;
-}
-
-void checkSamePoints(const Scan& a, const Scan& b, double tolerance) {
-  REQUIRE(a.size() == b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    CAPTURE(i);
-    CHECK((a.points[i] - b.points[i]).norm() < tolerance);
-  }
 }
 
 }  // namespace

@@ -18,6 +18,7 @@ using mlmap::Pose;
 using mlmap::Scan;
 using mlmap::io::readScanGraph;
 using mlmap::io::writeScanGraph;
+using mlmap::test::contains;
 using mlmap::test::readText;
 using mlmap::test::TempDir;
 using mlmap::test::writeText;
@@ -40,15 +41,7 @@ std::vector<Scan> twoScans() {
 }
 
 std::string graphError(const TempDir& dir, const std::string& bytes) {
-  const auto path = dir / "bad.graph";
-  writeText(path, bytes);
-  try {
-    readScanGraph(path);
-  } catch (const Error& error) {
-    return error.what();
-  }
-  FAIL("no mlmap::Error for a " << bytes.size() << "-byte file");
-  return {};
+  return mlmap::test::errorReading(dir / "bad.graph", bytes, readScanGraph);
 }
 
 void putU32(std::string& bytes, std::size_t offset, std::uint32_t value) {
@@ -119,29 +112,28 @@ TEST_CASE("scan_graph: hostile binary files are rejected before allocating") {
     std::string bytes = good;
     putU32(bytes, 0, 0xFFFFFFFFu);
     const std::string message = graphError(dir, bytes);
-    CHECK(message.find("bad.graph: byte 0") != std::string::npos);
-    CHECK(message.find("4294967295 scans") != std::string::npos);
+    CHECK(contains(message, "bad.graph: byte 0"));
+    CHECK(contains(message, "4294967295 scans"));
   }
   SUBCASE("giant point count") {
     std::string bytes = good;
     putU32(bytes, 4, 0xFFFFFFF0u);
     const std::string message = graphError(dir, bytes);
-    CHECK(message.find("bad.graph: byte 4") != std::string::npos);
-    CHECK(message.find("points") != std::string::npos);
+    CHECK(contains(message, "bad.graph: byte 4"));
+    CHECK(contains(message, "points"));
   }
   SUBCASE("truncated") {
-    CHECK(graphError(dir, good.substr(0, good.size() - 100)).find("bad.graph: byte") !=
-          std::string::npos);
+    CHECK(contains(graphError(dir, good.substr(0, good.size() - 100)), "bad.graph: byte"));
   }
   SUBCASE("trailing garbage") {
-    CHECK(graphError(dir, good + "xyz").find("bad.graph: byte") != std::string::npos);
+    CHECK(contains(graphError(dir, good + "xyz"), "bad.graph: byte"));
   }
   SUBCASE("zero scans") {
-    CHECK(graphError(dir, std::string(8, '\0'))
-              .find("bad.graph: byte 0: scan graph holds no scans") != std::string::npos);
+    CHECK(contains(graphError(dir, std::string(8, '\0')),
+                   "bad.graph: byte 0: scan graph holds no scans"));
   }
   SUBCASE("too short") {
-    CHECK(graphError(dir, "ab").find("bad.graph: byte 0") != std::string::npos);
+    CHECK(contains(graphError(dir, "ab"), "bad.graph: byte 0"));
   }
   SUBCASE("zero quaternion") {
     std::string bytes = good;
@@ -150,36 +142,34 @@ TEST_CASE("scan_graph: hostile binary files are rejected before allocating") {
     const std::size_t quaternion = 4 + 4 + 300 * 28 + 28 + 4;
     std::memset(bytes.data() + quaternion, 0, 32);
     const std::string message = graphError(dir, bytes);
-    CHECK(message.find("bad.graph: byte " + std::to_string(4 + 4 + 300 * 28)) != std::string::npos);
+    CHECK(contains(message, "bad.graph: byte " + std::to_string(4 + 4 + 300 * 28)));
   }
   SUBCASE("nan point") {
     std::string bytes = good;
     const double nan = std::nan("");
     std::memcpy(bytes.data() + 4 + 4 + 5 * 28 + 4, &nan, sizeof(nan));
     const std::string message = graphError(dir, bytes);
-    CHECK(message.find("byte " + std::to_string(4 + 4 + 5 * 28)) != std::string::npos);
-    CHECK(message.find("point 5") != std::string::npos);
+    CHECK(contains(message, "byte " + std::to_string(4 + 4 + 5 * 28)));
+    CHECK(contains(message, "point 5"));
   }
 }
 
 TEST_CASE("scan_graph: bad ASCII logs name file and line") {
   TempDir dir;
   SUBCASE("point before NODE") {
-    CHECK(graphError(dir, "# c\n1 2 3\n").find("bad.graph:2: point before the first NODE") !=
-          std::string::npos);
+    CHECK(contains(graphError(dir, "# c\n1 2 3\n"), "bad.graph:2: point before the first NODE"));
   }
   SUBCASE("NODE without a pose") {
-    CHECK(graphError(dir, "# c\nNODE\n").find("bad.graph:2") != std::string::npos);
+    CHECK(contains(graphError(dir, "# c\nNODE\n"), "bad.graph:2"));
   }
   SUBCASE("non-numeric point") {
-    CHECK(graphError(dir, "NODE 0 0 0 0 0 0\n1 2 x\n").find("bad.graph:2") != std::string::npos);
+    CHECK(contains(graphError(dir, "NODE 0 0 0 0 0 0\n1 2 x\n"), "bad.graph:2"));
   }
   SUBCASE("short point") {
-    CHECK(graphError(dir, "NODE 0 0 0 0 0 0\n1 2 3\n1 2\n").find("bad.graph:3") !=
-          std::string::npos);
+    CHECK(contains(graphError(dir, "NODE 0 0 0 0 0 0\n1 2 3\n1 2\n"), "bad.graph:3"));
   }
   SUBCASE("comments only") {
-    CHECK(graphError(dir, "# nothing\n").find("bad.graph:1: no NODE") != std::string::npos);
+    CHECK(contains(graphError(dir, "# nothing\n"), "bad.graph:1: no NODE"));
   }
 }
 

@@ -3,7 +3,6 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <random>
 #include <string>
 #include <unordered_map>
 
@@ -17,6 +16,7 @@ using mlmap::Pose;
 using mlmap::Scan;
 using mlmap::io::readThreeDtkScan;
 using mlmap::io::writeThreeDtkScan;
+using mlmap::test::contains;
 using mlmap::test::TempDir;
 using mlmap::test::writeText;
 
@@ -46,15 +46,8 @@ Eigen::Vector3d fromThreeDtk(const Eigen::Vector3d& p) {
 
 std::string threeDtkError(const TempDir& dir, const std::string& scan_text,
                           const std::string& pose_text) {
-  writeText(dir / "scan000.3d", scan_text);
   writeText(dir / "scan000.pose", pose_text);
-  try {
-    readThreeDtkScan(dir / "scan000.3d");
-  } catch (const Error& error) {
-    return error.what();
-  }
-  FAIL("no mlmap::Error for: " << scan_text << " / " << pose_text);
-  return {};
+  return mlmap::test::errorReading(dir / "scan000.3d", scan_text, readThreeDtkScan);
 }
 
 // Least-squares plane through the points around `seed` (a height band first,
@@ -192,35 +185,31 @@ TEST_CASE("threedtk: skips the old '360 x 225' header on line 1 only") {
   writeText(dir / "scan000.pose", "0 0 0 0 0 0");
   CHECK(readThreeDtkScan(dir / "scan000.3d").size() == 1);
   const std::string message = threeDtkError(dir, "1 2 3\n360 x 225\n", "0 0 0\n0 0 0\n");
-  CHECK(message.find("scan000.3d:2") != std::string::npos);
+  CHECK(contains(message, "scan000.3d:2"));
 }
 
 TEST_CASE("threedtk: bad input names file and line") {
   TempDir dir;
   SUBCASE("short point line") {
     const std::string message = threeDtkError(dir, "1 2 3\n4 5\n", "0 0 0\n0 0 0\n");
-    CHECK(message.find("scan000.3d:2") != std::string::npos);
+    CHECK(contains(message, "scan000.3d:2"));
   }
   SUBCASE("nan point") {
-    CHECK(threeDtkError(dir, "1 2 nan\n", "0 0 0\n0 0 0\n").find("scan000.3d:1") !=
-          std::string::npos);
+    CHECK(contains(threeDtkError(dir, "1 2 nan\n", "0 0 0\n0 0 0\n"), "scan000.3d:1"));
   }
   SUBCASE("empty scan") {
-    CHECK(threeDtkError(dir, "", "0 0 0\n0 0 0\n").find("scan000.3d:1: no points") !=
-          std::string::npos);
+    CHECK(contains(threeDtkError(dir, "", "0 0 0\n0 0 0\n"), "scan000.3d:1: no points"));
   }
   SUBCASE("pose with five numbers") {
     const std::string message = threeDtkError(dir, "1 2 3\n", "0 0 0\n0 0\n");
-    CHECK(message.find("scan000.pose:2") != std::string::npos);
-    CHECK(message.find("found 5") != std::string::npos);
+    CHECK(contains(message, "scan000.pose:2"));
+    CHECK(contains(message, "found 5"));
   }
   SUBCASE("pose with seven numbers") {
-    CHECK(threeDtkError(dir, "1 2 3\n", "0 0 0\n0 0 0\n7\n").find("scan000.pose:3") !=
-          std::string::npos);
+    CHECK(contains(threeDtkError(dir, "1 2 3\n", "0 0 0\n0 0 0\n7\n"), "scan000.pose:3"));
   }
   SUBCASE("non-numeric pose") {
-    CHECK(threeDtkError(dir, "1 2 3\n", "0 0 0\nx 0 0\n").find("scan000.pose:2") !=
-          std::string::npos);
+    CHECK(contains(threeDtkError(dir, "1 2 3\n", "0 0 0\nx 0 0\n"), "scan000.pose:2"));
   }
   SUBCASE("missing pose file") {
     writeText(dir / "scan001.3d", "1 2 3\n");
@@ -235,11 +224,7 @@ TEST_CASE("threedtk: bad input names file and line") {
 
 TEST_CASE("threedtk: write then read round-trips points and pose") {
   TempDir dir;
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> coordinate(-30.0, 30.0);
-  Scan scan;
-  for (int i = 0; i < 500; ++i)
-    scan.points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
+  Scan scan = mlmap::test::randomScan(500, 3, 30.0);
   scan.pose.linear() = (Eigen::AngleAxisd(2.5, Eigen::Vector3d(1, -2, 0.5).normalized()) *
                         Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitZ()))
                            .toRotationMatrix();
@@ -260,11 +245,7 @@ TEST_CASE("threedtk: write then read round-trips points and pose") {
   writeThreeDtkScan(dir / "scan007.3d", scan);
   REQUIRE(std::filesystem::exists(dir / "scan007.pose"));
   const Scan back = readThreeDtkScan(dir / "scan007.3d");
-  REQUIRE(back.size() == scan.size());
-  for (std::size_t i = 0; i < scan.size(); ++i) {
-    INFO("point " << i);
-    CHECK((back.points[i] - scan.points[i]).norm() < 1e-12);
-  }
+  mlmap::test::checkSamePoints(back, scan, 1e-12);
   CHECK((back.pose.matrix() - scan.pose.matrix()).norm() < 1e-9);
 }
 

@@ -13,21 +13,14 @@ using mlmap::Pose;
 using mlmap::io::readTumPoses;
 using mlmap::io::StampedPose;
 using mlmap::io::writeTumPoses;
+using mlmap::test::contains;
 using mlmap::test::TempDir;
 using mlmap::test::writeText;
 
 namespace {
 
 std::string tumError(const TempDir& dir, const std::string& text) {
-  const auto path = dir / "poses.txt";
-  writeText(path, text);
-  try {
-    readTumPoses(path);
-  } catch (const Error& error) {
-    return error.what();
-  }
-  FAIL("no mlmap::Error for: " << text);
-  return {};
+  return mlmap::test::errorReading(dir / "poses.txt", text, readTumPoses);
 }
 
 Pose makePose(const Eigen::Vector3d& axis, double angle, const Eigen::Vector3d& translation) {
@@ -72,28 +65,28 @@ TEST_CASE("tum: bad input names file and line") {
   TempDir dir;
   SUBCASE("wrong field count") {
     const std::string message = tumError(dir, "0 0 0 0 0 0 0 1\n# c\n1 2 3 0 0 0 1\n");
-    CHECK(message.find("poses.txt:3") != std::string::npos);
-    CHECK(message.find("found 7") != std::string::npos);
+    CHECK(contains(message, "poses.txt:3"));
+    CHECK(contains(message, "found 7"));
   }
   SUBCASE("too many fields") {
-    CHECK(tumError(dir, "0 0 0 0 0 0 0 1 9\n").find("poses.txt:1") != std::string::npos);
+    CHECK(contains(tumError(dir, "0 0 0 0 0 0 0 1 9\n"), "poses.txt:1"));
   }
   SUBCASE("zero quaternion") {
     const std::string message = tumError(dir, "0 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 0\n");
-    CHECK(message.find("poses.txt:2") != std::string::npos);
-    CHECK(message.find("zero length") != std::string::npos);
+    CHECK(contains(message, "poses.txt:2"));
+    CHECK(contains(message, "zero length"));
   }
   SUBCASE("non-numeric field") {
-    CHECK(tumError(dir, "0 0 zero 0 0 0 0 1\n").find("poses.txt:1") != std::string::npos);
+    CHECK(contains(tumError(dir, "0 0 zero 0 0 0 0 1\n"), "poses.txt:1"));
   }
   SUBCASE("nan") {
-    CHECK(tumError(dir, "\n0 0 0 0 nan 0 0 1\n").find("poses.txt:2") != std::string::npos);
+    CHECK(contains(tumError(dir, "\n0 0 0 0 nan 0 0 1\n"), "poses.txt:2"));
   }
   SUBCASE("huge quaternion") {
-    CHECK(tumError(dir, "0 0 0 0 1e300 1e300 0 1\n").find("poses.txt:1") != std::string::npos);
+    CHECK(contains(tumError(dir, "0 0 0 0 1e300 1e300 0 1\n"), "poses.txt:1"));
   }
   SUBCASE("empty file") {
-    CHECK(tumError(dir, "").find("poses.txt:1: no poses") != std::string::npos);
+    CHECK(contains(tumError(dir, ""), "poses.txt:1: no poses"));
   }
   SUBCASE("missing file") {
     CHECK_THROWS_WITH_AS(readTumPoses(dir / "none.txt"),

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <random>
 #include <string>
 
 #include "helpers.hpp"
@@ -14,6 +13,7 @@ using mlmap::Error;
 using mlmap::Scan;
 using mlmap::io::readXyz;
 using mlmap::io::writeXyz;
+using mlmap::test::contains;
 using mlmap::test::TempDir;
 using mlmap::test::writeText;
 
@@ -21,15 +21,7 @@ namespace {
 
 // The message of the Error that reading `text` as an XYZ file throws.
 std::string xyzError(const TempDir& dir, const std::string& text) {
-  const auto path = dir / "bad.xyz";
-  writeText(path, text);
-  try {
-    readXyz(path);
-  } catch (const Error& error) {
-    return error.what();
-  }
-  FAIL("no mlmap::Error for: " << text);
-  return {};
+  return mlmap::test::errorReading(dir / "bad.xyz", text, readXyz);
 }
 
 }  // namespace
@@ -69,49 +61,49 @@ TEST_CASE("xyz: bad input names file and line") {
   TempDir dir;
   SUBCASE("short line") {
     const std::string message = xyzError(dir, "1 2 3\n\n4 5\n");
-    CHECK(message.find("bad.xyz:3") != std::string::npos);
-    CHECK(message.find("3 fields") != std::string::npos);
+    CHECK(contains(message, "bad.xyz:3"));
+    CHECK(contains(message, "3 fields"));
   }
   SUBCASE("non-numeric field") {
     const std::string message = xyzError(dir, "1 2 3\n1 2 abc\n");
-    CHECK(message.find("bad.xyz:2") != std::string::npos);
-    CHECK(message.find("'abc'") != std::string::npos);
+    CHECK(contains(message, "bad.xyz:2"));
+    CHECK(contains(message, "'abc'"));
   }
   SUBCASE("number followed by garbage") {
-    CHECK(xyzError(dir, "1 2 3x\n").find("bad.xyz:1") != std::string::npos);
+    CHECK(contains(xyzError(dir, "1 2 3x\n"), "bad.xyz:1"));
   }
   SUBCASE("double sign") {
-    CHECK(xyzError(dir, "1 2 +-3\n").find("bad.xyz:1") != std::string::npos);
+    CHECK(contains(xyzError(dir, "1 2 +-3\n"), "bad.xyz:1"));
   }
   SUBCASE("nan") {
     const std::string message = xyzError(dir, "1 2 3\n4 nan 6\n");
-    CHECK(message.find("bad.xyz:2") != std::string::npos);
-    CHECK(message.find("not finite") != std::string::npos);
+    CHECK(contains(message, "bad.xyz:2"));
+    CHECK(contains(message, "not finite"));
   }
-  SUBCASE("inf") { CHECK(xyzError(dir, "# c\n-inf 2 3\n").find("bad.xyz:2") != std::string::npos); }
+  SUBCASE("inf") { CHECK(contains(xyzError(dir, "# c\n-inf 2 3\n"), "bad.xyz:2")); }
   SUBCASE("overflowing number") {
-    CHECK(xyzError(dir, "1e999 2 3\n").find("bad.xyz:1") != std::string::npos);
+    CHECK(contains(xyzError(dir, "1e999 2 3\n"), "bad.xyz:1"));
   }
   SUBCASE("4th column on some lines only") {
     const std::string message = xyzError(dir, "1 2 3 1\n4 5 6 2\n7 8 9\n");
-    CHECK(message.find("bad.xyz:3") != std::string::npos);
+    CHECK(contains(message, "bad.xyz:3"));
   }
   SUBCASE("4th column appearing late") {
-    CHECK(xyzError(dir, "1 2 3\n4 5 6 2\n").find("bad.xyz:2") != std::string::npos);
+    CHECK(contains(xyzError(dir, "1 2 3\n4 5 6 2\n"), "bad.xyz:2"));
   }
   SUBCASE("non-numeric 4th column") {
-    CHECK(xyzError(dir, "1 2 3 red\n").find("bad.xyz:1") != std::string::npos);
+    CHECK(contains(xyzError(dir, "1 2 3 red\n"), "bad.xyz:1"));
   }
   SUBCASE("empty file") {
     const std::string message = xyzError(dir, "");
-    CHECK(message.find("bad.xyz:1") != std::string::npos);
-    CHECK(message.find("no points") != std::string::npos);
+    CHECK(contains(message, "bad.xyz:1"));
+    CHECK(contains(message, "no points"));
   }
   SUBCASE("comments only") {
-    CHECK(xyzError(dir, "# a\n# b\n\n").find("bad.xyz:3: no points") != std::string::npos);
+    CHECK(contains(xyzError(dir, "# a\n# b\n\n"), "bad.xyz:3: no points"));
   }
   SUBCASE("binary garbage") {
-    CHECK(xyzError(dir, std::string("\x01\x02\x00\xff", 4)).find("bad.xyz:1") != std::string::npos);
+    CHECK(contains(xyzError(dir, std::string("\x01\x02\x00\xff", 4)), "bad.xyz:1"));
   }
 }
 
@@ -123,13 +115,8 @@ TEST_CASE("xyz: missing file") {
 
 TEST_CASE("xyz: write then read round-trips to 1 um, labels exactly") {
   TempDir dir;
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> coordinate(-50.0, 50.0);
-  Scan scan;
-  for (int i = 0; i < 1000; ++i) {
-    scan.points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
-    scan.labels.push_back(i % 5 - 2);
-  }
+  Scan scan = mlmap::test::randomScan(1000, 7, 50.0);
+  for (int i = 0; i < 1000; ++i) scan.labels.push_back(i % 5 - 2);
   scan.points.emplace_back(0.0, -0.0, 1e-9);  // rounds to zero
   scan.labels.push_back(std::numeric_limits<std::int32_t>::min());
   scan.points.emplace_back(1e15, -2.5e13, 123.0);  // beyond the fixed-point range
