@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+#include "file_bytes.hpp"
+#include "number_text.hpp"
+
 namespace mlmap::io {
 
 double parseCoordinate(const TextLines& lines, std::string_view token, bool single_precision) {
@@ -11,6 +14,33 @@ double parseCoordinate(const TextLines& lines, std::string_view token, bool sing
     lines.fail("value does not fit a float: '" + std::string(token.substr(0, 40)) + "'");
   }
   return static_cast<float>(value);
+}
+
+std::vector<std::string_view> nextRowFields(TextLines& lines, std::uint64_t done,
+                                            std::uint64_t count, std::string_view rows) {
+  std::vector<std::string_view> fields;
+  do {
+    if (!lines.next()) {
+      lines.fail("file ends after " + std::to_string(done) + " of " + std::to_string(count) + " " +
+                 std::string(rows));
+    }
+    fields = lines.fields();
+  } while (fields.empty());
+  return fields;
+}
+
+void appendFloatXyz(std::string& out, const Point& point) {
+  appendNumber(out, static_cast<float>(point.x()));
+  out += ' ';
+  appendNumber(out, static_cast<float>(point.y()));
+  out += ' ';
+  appendNumber(out, static_cast<float>(point.z()));
+}
+
+void storeFloatXyz(char* row, const Point& point) {
+  storeLittleEndian(row, static_cast<float>(point.x()));
+  storeLittleEndian(row + 4, static_cast<float>(point.y()));
+  storeLittleEndian(row + 8, static_cast<float>(point.z()));
 }
 
 void requireLabelPerPoint(const std::filesystem::path& path, const Scan& scan) {

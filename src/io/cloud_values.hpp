@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "mlmap/error.hpp"
 #include "mlmap/scan.hpp"
@@ -33,6 +34,15 @@ inline std::string lineWhere(const TextLines& lines) {
 // A coordinate from a text body. Values of a float field are rounded to float, so
 // ascii and binary files give the same coordinates.
 double parseCoordinate(const TextLines& lines, std::string_view token, bool single_precision);
+
+// Moves `lines` to the next line that has fields and returns them; at the end of
+// the file fails with "file ends after <done> of <count> <rows>".
+std::vector<std::string_view> nextRowFields(TextLines& lines, std::uint64_t done,
+                                            std::uint64_t count, std::string_view rows);
+
+// Writers keep coordinates as float: "x y z" as text, or 12 little-endian bytes.
+void appendFloatXyz(std::string& out, const Point& point);
+void storeFloatXyz(char* row, const Point& point);
 
 // Throws mlmap::Error naming `path` unless the scan has no labels or one per point.
 void requireLabelPerPoint(const std::filesystem::path& path, const Scan& scan);

@@ -372,14 +372,7 @@ void readAscii(const Header& header, TextLines& lines, std::size_t remaining_byt
   // Each value takes at least two characters: never reserve more than the file holds.
   scan.points.reserve(std::min<std::uint64_t>(header.points, remaining_bytes / (2 * values_per_point) + 1));
   for (std::uint64_t i = 0; i < header.points; ++i) {
-    std::vector<std::string_view> values;
-    do {
-      if (!lines.next()) {
-        lines.fail("file ends after " + std::to_string(i) + " of " + std::to_string(header.points) +
-                   " points");
-      }
-      values = lines.fields();
-    } while (values.empty());
+    const auto values = nextRowFields(lines, i, header.points, "points");
     if (values.size() != values_per_point) {
       lines.fail("point line has " + std::to_string(values.size()) + " values, expected " +
                  std::to_string(values_per_point));
@@ -464,12 +457,7 @@ void writePcd(const std::filesystem::path& path, const Scan& scan, PcdEncoding e
   if (format == Encoding::Ascii) {
     out.reserve(out.size() + count * (with_labels ? 48 : 40));
     for (std::size_t i = 0; i < count; ++i) {
-      const Point& point = scan.points[i];
-      appendNumber(out, static_cast<float>(point.x()));
-      out += ' ';
-      appendNumber(out, static_cast<float>(point.y()));
-      out += ' ';
-      appendNumber(out, static_cast<float>(point.z()));
+      appendFloatXyz(out, scan.points[i]);
       if (with_labels) {
         out += ' ';
         if (signed_labels) appendNumber(out, scan.labels[i]);
@@ -482,10 +470,7 @@ void writePcd(const std::filesystem::path& path, const Scan& scan, PcdEncoding e
     out.resize(header_bytes + count * point_bytes);
     char* row = out.data() + header_bytes;
     for (std::size_t i = 0; i < count; ++i, row += point_bytes) {
-      const Point& point = scan.points[i];
-      storeLittleEndian(row, static_cast<float>(point.x()));
-      storeLittleEndian(row + 4, static_cast<float>(point.y()));
-      storeLittleEndian(row + 8, static_cast<float>(point.z()));
+      storeFloatXyz(row, scan.points[i]);
       if (with_labels) storeLittleEndian(row + 12, scan.labels[i]);
     }
   } else {

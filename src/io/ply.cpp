@@ -325,14 +325,8 @@ void readBinaryVertices(BinaryBody& body, const Element& vertex, const VertexLay
 // Skips `count` rows of a non-vertex element: one element per line.
 void skipAsciiElement(TextLines& lines, const Element& element) {
   if (element.properties.empty()) return;  // rows without values take no line
-  for (std::uint64_t i = 0; i < element.count; ++i) {
-    do {
-      if (!lines.next()) {
-        lines.fail("file ends after " + std::to_string(i) + " of " +
-                   std::to_string(element.count) + " " + element.name + " lines");
-      }
-    } while (lines.fields().empty());
-  }
+  const std::string rows = element.name + " lines";
+  for (std::uint64_t i = 0; i < element.count; ++i) nextRowFields(lines, i, element.count, rows);
 }
 
 void readAsciiVertices(TextLines& lines, const Element& vertex, const VertexLayout& layout,
@@ -342,14 +336,7 @@ void readAsciiVertices(TextLines& lines, const Element& vertex, const VertexLayo
   const std::size_t min_line_bytes = 2 * vertex.properties.size();
   scan.points.reserve(std::min<std::uint64_t>(vertex.count, remaining_bytes / min_line_bytes + 1));
   for (std::uint64_t i = 0; i < vertex.count; ++i) {
-    std::vector<std::string_view> fields;
-    do {
-      if (!lines.next()) {
-        lines.fail("file ends after " + std::to_string(i) + " of " + std::to_string(vertex.count) +
-                   " vertex lines");
-      }
-      fields = lines.fields();
-    } while (fields.empty());
+    const auto fields = nextRowFields(lines, i, vertex.count, "vertex lines");
     std::size_t field = 0;
     Point point = Point::Zero();
     std::int32_t label = 0;
@@ -437,12 +424,7 @@ void writePly(const std::filesystem::path& path, const Scan& scan, PlyEncoding e
   if (encoding == PlyEncoding::Ascii) {
     out.reserve(out.size() + scan.size() * (with_labels ? 48 : 40));
     for (std::size_t i = 0; i < scan.size(); ++i) {
-      const Point& point = scan.points[i];
-      appendNumber(out, static_cast<float>(point.x()));
-      out += ' ';
-      appendNumber(out, static_cast<float>(point.y()));
-      out += ' ';
-      appendNumber(out, static_cast<float>(point.z()));
+      appendFloatXyz(out, scan.points[i]);
       if (with_labels) {
         out += ' ';
         appendNumber(out, scan.labels[i]);
@@ -455,10 +437,7 @@ void writePly(const std::filesystem::path& path, const Scan& scan, PlyEncoding e
     out.resize(header_bytes + scan.size() * row_bytes);
     char* row = out.data() + header_bytes;
     for (std::size_t i = 0; i < scan.size(); ++i, row += row_bytes) {
-      const Point& point = scan.points[i];
-      storeLittleEndian(row, static_cast<float>(point.x()));
-      storeLittleEndian(row + 4, static_cast<float>(point.y()));
-      storeLittleEndian(row + 8, static_cast<float>(point.z()));
+      storeFloatXyz(row, scan.points[i]);
       if (with_labels) storeLittleEndian(row + 12, scan.labels[i]);
     }
   }
