@@ -11,8 +11,8 @@
 
 #include "captured_cerr.hpp"
 #include "crc32.hpp"
+#include "file_bytes.hpp"
 #include "mlmap/error.hpp"
-#include "mlmap/io/atomic_file.hpp"
 
 namespace mlmap::io {
 namespace {
@@ -72,14 +72,6 @@ class ByteReader {
   std::size_t offset_ = 0;
 };
 
-std::string readWholeFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open (no such file or no permission)");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw Error(path.string() + ": read error");
-  return bytes;
-}
-
 }  // namespace
 
 void writeMap(const std::filesystem::path& path, const Map& map) {
@@ -122,9 +114,7 @@ void writeMap(const std::filesystem::path& path, const Map& map) {
   put<std::uint64_t>(out, octree_bytes.size());
   out += octree_bytes;
   put<std::uint32_t>(out, crc32(out.data(), out.size()));
-  writeAtomically(path, [&](std::ostream& stream) {
-    stream.write(out.data(), static_cast<std::streamsize>(out.size()));
-  });
+  writeWholeFile(path, out);
 }
 
 Map readMap(const std::filesystem::path& path) {
