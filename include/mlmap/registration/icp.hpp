@@ -1,0 +1,64 @@
+// ICP: aligns a (down-sampled) source cloud to a VoxelHashMap, point-to-plane (normals
+// from the map's neighbourhoods) or point-to-point, with a Geman–McClure kernel, solved
+// from the 6×6 normal equations (Eigen, no Ceres). The adaptive threshold: the
+// correspondence gate shrinks to 3× the residuals' robust spread plus the last step's
+// motion, and the kernel scale is a third of the gate.
+// The result says when it cannot be trusted: too few inliers, or degenerate geometry (a
+// near-zero eigenvalue of the normal equations, e.g. along a featureless corridor).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+#include "mlmap/registration/voxel_hash_map.hpp"
+#include "mlmap/scan.hpp"
+
+namespace mlmap::registration {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+enum class IcpMetric { PointToPlane, PointToPoint };
+
+struct IcpConfig {
+  IcpMetric metric = IcpMetric::PointToPlane;
+  double initial_max_distance = 1.0;  // m, correspondence gate at the first iteration
+  double min_max_distance = 0.1;      // m, the gate never shrinks below this
+  double min_kernel_scale = 0.01;     // m, floor of the kernel scale (range noise)
+  int max_iterations = 60;
+  double convergence_translation = 1e-4;  // m, converged when an update moves less than this
+  double convergence_rotation = 1e-5;     // rad, ... and turns less than this
+  std::size_t min_inliers = 100;          // fewer: unreliable
+  double min_eigenvalue_ratio = 5e-3;     // λ_min/λ_max of the scaled normal equations below: degenerate
+};
+
+struct IcpResult {
+  Pose pose = Pose::Identity();  // source -> target frame
+  std::size_t source_points = 0;
+  std::size_t inliers = 0;       // correspondences within the final gate
+  double rms_residual = 0.0;     // m, of the inliers' residuals (point-to-plane or -point)
+  int iterations = 0;
+  bool converged = false;
+  bool degenerate = false;
+  bool unreliable = true;        // too few inliers, degenerate or not converged
+  double eigenvalue_ratio = 0.0; // λ_min/λ_max, rotations scaled to metres at the cloud's radius
+  // The normal equations JᵀWJ at the result, for a pose update T ← Exp_pivot(ω, v)·T:
+  // rotate by ω about `pivot`, then translate by v (target frame). Pose graphs use it as
+  // the information of the result, divided by the residual variance.
+  Matrix6d hessian = Matrix6d::Zero();
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
+  double kernel_scale = 0.0;     // m, the final Geman–McClure scale
+};
+
+// Aligns `source` (in its own frame) to `target`, starting from `initial_guess`
+// (source -> target). With point-to-plane, map points without a normal are skipped.
+IcpResult alignPoints(const std::vector<Point>& source, const VoxelHashMap& target,
+                      const Pose& initial_guess, const IcpConfig& config = {});
+
+// Exp_pivot(ω, v): rotation by the rotation vector ω about `pivot`, then translation v.
+Pose applyIncrement(const Vector6d& increment, const Eigen::Vector3d& pivot, const Pose& pose);
+// The inverse of Exp_pivot for a small transform `delta` (its (ω, v)).
+Vector6d incrementOf(const Pose& delta, const Eigen::Vector3d& pivot);
+
+}  // namespace mlmap::registration

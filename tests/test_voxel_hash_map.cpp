@@ -1,0 +1,124 @@
+// VoxelHashMap: every query against brute force, on random and structured clouds.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "helpers.hpp"
+#include "mlmap/registration/voxel_hash_map.hpp"
+
+namespace {
+
+using mlmap::Point;
+using mlmap::registration::VoxelHashMap;
+
+std::optional<double> bruteNearest(const std::vector<Point>& cloud, const Point& query, double max_distance) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Point& point : cloud) best = std::min(best, (point - query).norm());
+  if (best > max_distance) return std::nullopt;
+  return best;
+}
+
+// Three walls of a room, a floor and a staircase, sampled on a 2 cm grid with noise.
+std::vector<Point> structuredCloud(unsigned seed) {
+  std::mt19937 generator(seed);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  std::vector<Point> cloud;
+  for (double a = 0.0; a < 3.0; a += 0.02) {
+    for (double b = 0.0; b < 2.0; b += 0.02) {
+      cloud.emplace_back(a, b, noise(generator));           // floor
+      cloud.emplace_back(noise(generator), b, a * 0.8);     // wall x = 0
+      cloud.emplace_back(a, noise(generator), b * 1.2);     // wall y = 0
+    }
+  }
+  for (int step = 0; step < 5; ++step) {
+    for (double y = 0.5; y < 1.5; y += 0.02) {
+      for (double t = 0.0; t < 0.28; t += 0.02) cloud.emplace_back(1.0 + step * 0.28 + t, y, 0.17 * (step + 1));
+    }
+  }
+  return cloud;
+}
+
+void checkAgainstBruteForce(const std::vector<Point>& cloud, double voxel_size, double max_distance,
+                            unsigned seed, double extent) {
+  VoxelHashMap map(voxel_size, cloud.size());  // no per-voxel cap: every point is kept
+  map.addPoints(cloud);
+  REQUIRE(map.size() == cloud.size());
+  std::mt19937 generator(seed);
+  std::uniform_real_distribution<double> coordinate(-0.5, extent + 0.5);
+  std::uniform_real_distribution<double> offset(-max_distance, max_distance);
+  std::uniform_int_distribution<std::size_t> pick(0, cloud.size() - 1);
+  int found = 0;
+  for (int q = 0; q < 500; ++q) {
+    // Every other query lies near a cloud point, the rest anywhere around the cloud.
+    const Point query = q % 2 == 0 ? Point(coordinate(generator), coordinate(generator), coordinate(generator))
+                                   : Point(cloud[pick(generator)] + Point(offset(generator), offset(generator),
+                                                                          offset(generator)));
+    const auto expected = bruteNearest(cloud, query, max_distance);
+    const auto neighbour = map.nearest(query, max_distance);
+    CAPTURE(q);
+    REQUIRE(neighbour.has_value() == expected.has_value());
+    if (!expected) continue;
+    ++found;
+    CHECK(neighbour->distance == doctest::Approx(*expected).epsilon(1e-12));
+    CHECK((neighbour->point - query).norm() == doctest::Approx(neighbour->distance).epsilon(1e-12));
+    // within(): exactly the brute-force set.
+    std::size_t inside = 0;
+    for (const Point& point : cloud) inside += (point - query).norm() <= max_distance ? 1 : 0;
+    CHECK(map.within(query, max_distance).size() == inside);
+  }
+  CHECK(found > 100);  // the queries exercised real hits, not only misses
+}
+
+}  // namespace
+
+TEST_CASE("VoxelHashMap: nearest and within match brute force on random clouds") {
+  const mlmap::Scan scan = mlmap::test::randomScan(3000, 7, 1.5);
+  std::vector<Point> cloud = scan.points;
+  for (Point& point : cloud) point += Point::Constant(1.5);  // [0, 3)³, crossing no key sign
+  // Gates smaller than, equal to and several times the voxel size.
+  checkAgainstBruteForce(cloud, 0.1, 0.05, 1, 3.0);
+  checkAgainstBruteForce(cloud, 0.1, 0.1, 2, 3.0);
+  checkAgainstBruteForce(cloud, 0.1, 0.35, 3, 3.0);
+  checkAgainstBruteForce(scan.points, 0.25, 0.2, 4, 1.5);  // negative coordinates too
+}
+
+TEST_CASE("VoxelHashMap: nearest and within match brute force on a structured cloud") {
+  const std::vector<Point> cloud = structuredCloud(5);
+  checkAgainstBruteForce(cloud, 0.1, 0.08, 6, 3.0);
+  checkAgainstBruteForce(cloud, 0.05, 0.3, 7, 3.0);
+}
+
+TEST_CASE("VoxelHashMap: voxels keep at most max points; empty map finds nothing") {
+  VoxelHashMap map(0.5, 3);
+  CHECK_FALSE(map.nearest(Point::Zero(), 10.0).has_value());
+  std::vector<Point> same(10, Point(0.1, 0.1, 0.1));
+  same.emplace_back(2.0, 2.0, 2.0);
+  map.addPoints(same);
+  CHECK(map.size() == 4);
+  CHECK(map.voxelCount() == 2);
+  CHECK(map.points().size() == 4);
+  CHECK_FALSE(map.nearest(Point(5, 5, 5), 1.0).has_value());
+  CHECK_THROWS_AS(VoxelHashMap(0.0), mlmap::Error);
+}
+
+TEST_CASE("VoxelHashMap: normals of a plane, none on a line") {
+  VoxelHashMap map(0.1);
+  std::vector<Point> plane;
+  for (double x = 0.0; x < 1.0; x += 0.02) {
+    for (double y = 0.0; y < 1.0; y += 0.02) plane.emplace_back(x, y, 0.3 * x);
+  }
+  std::vector<Point> line;
+  for (double x = 0.0; x < 1.0; x += 0.01) line.emplace_back(x, 5.0, 5.0);
+  map.addPoints(plane);
+  map.addPoints(line);
+  map.estimateNormals();
+  const Eigen::Vector3d expected = Eigen::Vector3d(-0.3, 0.0, 1.0).normalized();
+  const auto on_plane = map.nearest(Point(0.5, 0.5, 0.15), 0.05);
+  REQUIRE(on_plane);
+  CHECK(std::abs(on_plane->normal.dot(expected)) == doctest::Approx(1.0).epsilon(1e-6));
+  const auto on_line = map.nearest(Point(0.5, 5.0, 5.0), 0.05);
+  REQUIRE(on_line);
+  CHECK(on_line->normal.isZero());
+}
