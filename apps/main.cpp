@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   CLI::App app{"mlmap: Multi-Level maps from 3D laser scans, and the planes in them"};
   app.set_version_flag("--version", "mlmap 0.1.0");
   app.require_subcommand(1);
+  app.fallthrough();  // --quiet also after the subcommand
   mlmap::cli::Context context;
   app.add_flag("-q,--quiet", context.quiet, "No progress on stderr");
   mlmap::cli::addCommands(app, context);

@@ -1,0 +1,79 @@
+// mlmap label: every input point, in input order, in the world frame, with the patch
+// id of the block that collected it ("x y z id", −1 for none).
+#include <cstdio>
+
+#include "commands.hpp"
+#include "mlmap/error.hpp"
+#include "mlmap/io/map_file.hpp"
+#include "mlmap/io/scan_file.hpp"
+#include "mlmap/io/tum_poses.hpp"
+#include "mlmap/io/xyz.hpp"
+#include "mlmap/planes/point_labels.hpp"
+#include "progress.hpp"
+
+namespace mlmap::cli {
+namespace {
+
+struct LabelArguments {
+  std::string map;
+  std::string poses;
+  std::string output;
+  std::vector<std::string> scans;
+};
+
+int runLabel(const LabelArguments& arguments, bool quiet) {
+  const Map map = io::readMap(arguments.map);
+  std::vector<io::StampedPose> poses;
+  if (!arguments.poses.empty()) poses = io::readTumPoses(arguments.poses);
+  Scan labelled;  // all points, world frame
+  std::size_t scan_count = 0;
+  std::size_t with_plane = 0;
+  Progress progress("label", arguments.scans.size(), !quiet);
+  for (std::size_t file = 0; file < arguments.scans.size(); ++file) {
+    for (Scan& scan : io::readScans(arguments.scans[file])) {
+      if (!poses.empty()) {
+        if (scan_count >= poses.size()) {
+          throw Error(arguments.poses + ": " + std::to_string(poses.size()) +
+                      " poses, but there are more scans");
+        }
+        scan.pose = poses[scan_count].pose;
+      }
+      ++scan_count;
+      const std::vector<std::int32_t> labels = labelPoints(map.blocks(), scan);
+      for (std::size_t k = 0; k < scan.size(); ++k) {
+        labelled.points.push_back(scan.worldPoint(k));
+        // Blocks without a plane and points no block collects are both "none" here.
+        labelled.labels.push_back(labels[k] > 0 ? labels[k] : -1);
+        with_plane += labels[k] > 0 ? 1 : 0;
+      }
+    }
+    progress.update(file + 1);
+  }
+  if (!poses.empty() && scan_count != poses.size()) {
+    throw Error(arguments.poses + ": " + std::to_string(poses.size()) + " poses for " +
+                std::to_string(scan_count) + " scans");
+  }
+  progress.finish();
+  io::writeXyz(arguments.output, labelled);
+  std::printf("%s: %zu points, %zu on a plane (%.1f %%)\n", arguments.output.c_str(), labelled.size(),
+              with_plane, labelled.size() == 0 ? 0.0 : 100.0 * static_cast<double>(with_plane) / static_cast<double>(labelled.size()));
+  return 0;
+}
+
+}  // namespace
+
+void addLabelCommand(CLI::App& app, Context& context) {
+  auto arguments = std::make_shared<LabelArguments>();
+  auto* command = app.add_subcommand(
+      "label", "Write every scan point in the world frame with the plane id of its block (x y z id, -1 for none)");
+  command->add_option("map", arguments->map, "Labelled map (.mlmap, from mlmap planes -o)")
+      ->required()->check(CLI::ExistingFile);
+  command->add_option("--poses", arguments->poses, "TUM pose file, one pose per scan in order");
+  command->add_option("-o,--output", arguments->output, "Points file to write (.xyz)")->required();
+  command->add_option("scans", arguments->scans, "Scan files")->required()->check(CLI::ExistingFile);
+  command->callback([arguments, &context] {
+    context.run = [arguments, &context] { return runLabel(*arguments, context.quiet); };
+  });
+}
+
+}  // namespace mlmap::cli

@@ -1,0 +1,23 @@
+// The planes JSON export (schema "mlmap.planes/1", web/planes.schema.json): every
+// patch with its class, plane, centroid, area, outline and fit, and the map's
+// metadata, parameters and timings. Read by the web dashboard.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "mlmap/map/map.hpp"
+#include "mlmap/planes/ermsm.hpp"
+
+namespace mlmap::io {
+
+constexpr const char* kPlanesSchema = "mlmap.planes/1";
+
+// The export as JSON text (2-space indented).
+std::string planesJson(const Map& map, const PlaneDetection& detection, const std::string& source_name);
+
+// Written atomically.
+void writePlanesJson(const std::filesystem::path& path, const Map& map, const PlaneDetection& detection,
+                     const std::string& source_name);
+
+}  // namespace mlmap::io

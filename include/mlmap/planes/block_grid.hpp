@@ -1,0 +1,62 @@
+// The blocks of an ML map as eRMSM sees them (section V): each block a point for
+// distances, its surface in surface units, its cell; and a dense grid over the
+// map's cells for neighbourhood queries in Chebyshev radius r.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "mlmap/map/ml_map.hpp"
+
+namespace mlmap {
+
+struct PlaneBlock {
+  Eigen::Vector3f point;  // m: cell centre at h (horizontal) or mid-height (vertical)
+  float top = 0.0F;       // m, h
+  float bottom = 0.0F;    // m, h − d
+  float surface = 1.0F;   // surface units: 1 (horizontal) or d / cell_size (vertical)
+  bool vertical = false;  // a vertical block at least a cell deep (shallower ones count as horizontal)
+  CellIndex cell;
+};
+
+class BlockGrid {
+ public:
+  explicit BlockGrid(const MLMap& map);
+
+  double cellSize() const { return cell_size_; }
+  const std::vector<PlaneBlock>& blocks() const { return blocks_; }
+  std::size_t size() const { return blocks_.size(); }
+
+  // Block ids of the map's cell number n are [firstBlockOfCell(n), firstBlockOfCell(n + 1)).
+  std::uint32_t firstBlockOfCell(std::size_t cell_number) const { return cell_first_[cell_number]; }
+
+  // Calls visit(block_id) for every block in cells within Chebyshev radius `radius` of `cell`.
+  template <typename Visit>
+  void forEachNeighbour(CellIndex cell, int radius, Visit&& visit) const {
+    const std::int64_t row_begin = std::max<std::int64_t>(cell.i - radius - min_i_, 0);
+    const std::int64_t row_end = std::min<std::int64_t>(cell.i + radius - min_i_, rows_ - 1);
+    const std::int64_t column_begin = std::max<std::int64_t>(cell.j - radius - min_j_, 0);
+    const std::int64_t column_end = std::min<std::int64_t>(cell.j + radius - min_j_, columns_ - 1);
+    for (std::int64_t row = row_begin; row <= row_end; ++row) {
+      for (std::int64_t column = column_begin; column <= column_end; ++column) {
+        const std::int32_t number = grid_[static_cast<std::size_t>(row * columns_ + column)];
+        if (number < 0) continue;
+        for (std::uint32_t id = cell_first_[number]; id < cell_first_[number + 1]; ++id) visit(id);
+      }
+    }
+  }
+
+ private:
+  double cell_size_;
+  std::vector<PlaneBlock> blocks_;
+  std::vector<std::uint32_t> cell_first_;  // per map cell number, plus one past the end
+  std::vector<std::int32_t> grid_;         // dense rows × columns of map cell numbers, −1 empty
+  std::int64_t min_i_ = 0;
+  std::int64_t min_j_ = 0;
+  std::int64_t rows_ = 0;
+  std::int64_t columns_ = 0;
+};
+
+}  // namespace mlmap

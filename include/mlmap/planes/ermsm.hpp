@@ -1,0 +1,55 @@
+// eRMSM, efficient RANSAC in Multilevel Surface Maps (section V): Algorithm 1 with
+// candidates seeded from three neighbouring blocks of similar direction, scored in
+// surface units, refitted by PCA (Algorithm 2) and accepted by eq. 10.
+// Deterministic for a given seed at any thread count.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "mlmap/map/ml_map.hpp"
+#include "mlmap/planes/plane.hpp"
+
+namespace mlmap {
+
+struct ErmsmConfig {
+  int radius = 2;                 // cells, Chebyshev radius r (direction vectors, candidate seeds)
+  double epsilon = 0.0;           // m, max block-plane distance ε; 0 = max(cell size, 0.02)
+  double kappa_deg = 25.0;        // deg, max angle between a block's direction and the plane, κ
+  double theta_deg = 15.0;        // deg, max angle between the three seeds' directions, θ
+  double min_probability = 0.99;  // p_t of eq. 10's acceptance test
+  double min_area = 0.15;         // m², s_m: a plane's minimal matched surface
+  double min_patch_area = 0.1;    // m², smaller connected patches go back to the pool
+  int min_patch_blocks = 6;       // blocks, and so do patches of fewer blocks
+  double max_direction_spread_deg = 10.0;  // deg, mean angle of a plane's blocks to its normal (curved surfaces fail)
+  int max_candidates = 4000;      // Max_cp: Algorithm 1 stops after this many candidates
+  int max_idle_candidates = 1000; // ... or after this many without an accepted plane
+  int batch_size = 16;            // candidates per iteration of Algorithm 1 (fixed, not per thread)
+  int max_refits = 5;             // Algorithm 2's iterations at most
+  double refit_gain = 1.0;        // surface units: Algorithm 2 stops when a refit gains less
+  std::uint64_t seed = 1;         // same seed, same planes, at any thread count
+  int threads = 0;                // OpenMP threads; 0 = OpenMP's default
+};
+
+struct ErmsmStats {
+  std::size_t blocks = 0;
+  std::size_t blocks_with_direction = 0;
+  std::size_t candidates = 0;          // generated in all
+  std::size_t scored = 0;              // fully scored (the rest re-found a listed plane)
+  std::size_t accepted = 0;            // accepted eRMSM planes (before the patch split)
+  std::size_t labelled_blocks = 0;
+  double direction_seconds = 0.0;
+  double detection_seconds = 0.0;   // Algorithm 1 with refits and patch splitting
+};
+
+struct PlaneDetection {
+  std::vector<Plane> planes;  // patches, ids 1..n in the order found
+  ErmsmStats stats;
+  ErmsmConfig config;         // with the defaults resolved (ε)
+};
+
+// Detects the planes of `map` and writes each block's patch id into Block::plane
+// (0 for none; labels from an earlier run are cleared first).
+PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& config = {});
+
+}  // namespace mlmap

@@ -1,0 +1,27 @@
+// Beyond the paper (as Schnabel's efficient RANSAC does): the blocks of an accepted
+// plane split into connected patches on the plane's own grid, so two tables at one
+// height are two patches; each patch gets its outline polygon on the plane.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "mlmap/planes/block_grid.hpp"
+
+namespace mlmap {
+
+struct Patch {
+  std::vector<std::uint32_t> blocks;       // block ids, ascending
+  double surface = 0.0;                    // surface units
+  std::vector<Eigen::Vector3d> outline;    // m, outer boundary on the plane, counter-clockwise about the normal
+};
+
+// Blocks are rasterised on a grid of cell_size in the plane (a vertical block over
+// its whole height); occupied grid cells within `gap_cells` (Chebyshev) of each other
+// are connected. Patches are returned largest first.
+std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
+                                    const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
+                                    int gap_cells = 2);
+
+}  // namespace mlmap

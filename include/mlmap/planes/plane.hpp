@@ -1,0 +1,30 @@
+// A detected planar patch: the output of eRMSM (section V) after splitting each
+// accepted plane into connected patches and classifying them.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+namespace mlmap {
+
+enum class PlaneClass : std::uint8_t { Floor, Ceiling, Wall, Table, Step, Other };
+
+std::string_view className(PlaneClass plane_class);  // "floor", "ceiling", ...
+
+struct Plane {
+  std::int32_t id = 0;                // the label π written into the map's blocks (≥ 1)
+  PlaneClass label = PlaneClass::Other;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, oriented consistently
+  double offset = 0.0;                // m, n·x + offset = 0
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // m, of its blocks' points
+  double area = 0.0;                  // m², its blocks' surface
+  std::size_t block_count = 0;
+  double rms = 0.0;                   // m, RMS distance of its blocks' points to the plane
+  std::vector<Eigen::Vector3d> outline;  // m, boundary polygon on the plane, counter-clockwise
+  std::int32_t source = 0;            // the accepted eRMSM plane it was split from (1-based)
+  std::int32_t candidates = 0;        // candidates generated before that plane was accepted
+};
+
+}  // namespace mlmap

@@ -1,0 +1,109 @@
+#include "plane_scorer.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace mlmap {
+namespace {
+
+constexpr int kElevationRows = 9;     // 10° each over [0°, 90°]
+constexpr int kAzimuthColumns = 36;   // 10° each over the full circle
+constexpr double kBinRadius = 7.1 * std::numbers::pi / 180.0;  // half the diagonal of a 10° bin
+
+int binOf(const Eigen::Vector3f& direction) {
+  // Unsigned axes: use the upper hemisphere's representative.
+  const Eigen::Vector3f axis = direction.z() < 0.0F ? Eigen::Vector3f(-direction) : direction;
+  const double elevation = std::asin(std::min(1.0F, axis.z()));
+  double azimuth = std::atan2(axis.y(), axis.x());
+  if (azimuth < 0.0) azimuth += 2.0 * std::numbers::pi;
+  const int row = std::min(kElevationRows - 1, static_cast<int>(elevation / (std::numbers::pi / 2) * kElevationRows));
+  const int column = std::min(kAzimuthColumns - 1, static_cast<int>(azimuth / (2 * std::numbers::pi) * kAzimuthColumns));
+  return row * kAzimuthColumns + column;
+}
+
+}  // namespace
+
+PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
+                         double epsilon, double kappa_rad)
+    : grid_(grid),
+      directions_(directions),
+      epsilon_(static_cast<float>(epsilon)),
+      cos_kappa_(static_cast<float>(std::cos(kappa_rad))),
+      cos_bin_reach_(static_cast<float>(std::cos(std::min(kappa_rad + kBinRadius, std::numbers::pi / 2)))),
+      bins_(kElevationRows * kAzimuthColumns),
+      taken_(grid.size(), 0) {
+  for (int row = 0; row < kElevationRows; ++row) {
+    for (int column = 0; column < kAzimuthColumns; ++column) {
+      const double elevation = (row + 0.5) * (std::numbers::pi / 2) / kElevationRows;
+      const double azimuth = (column + 0.5) * 2 * std::numbers::pi / kAzimuthColumns;
+      bins_[static_cast<std::size_t>(row * kAzimuthColumns + column)].axis =
+          Eigen::Vector3f(static_cast<float>(std::cos(elevation) * std::cos(azimuth)),
+                          static_cast<float>(std::cos(elevation) * std::sin(azimuth)),
+                          static_cast<float>(std::sin(elevation)));
+    }
+  }
+  for (std::uint32_t id = 0; id < grid.size(); ++id) {
+    if (directions[id].squaredNorm() > 0.0F) bins_[static_cast<std::size_t>(binOf(directions[id]))].ids.push_back(id);
+  }
+}
+
+template <typename Visit>
+void PlaneScorer::forEachSimilar(const CandidatePlane& plane, Visit&& visit) const {
+  const auto& blocks = grid_.blocks();
+  for (const Bin& bin : bins_) {
+    if (bin.ids.empty() || std::abs(bin.axis.dot(plane.normal)) < cos_bin_reach_) continue;
+    for (const std::uint32_t id : bin.ids) {
+      if (taken_[id] != 0) continue;
+      if (std::abs(directions_[id].dot(plane.normal)) < cos_kappa_) continue;
+      visit(id, blocks[id]);
+    }
+  }
+}
+
+PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
+  PlaneScore result;
+  const float offset = -plane.normal.dot(plane.point);
+  forEachSimilar(plane, [&](std::uint32_t, const PlaneBlock& block) {
+    result.similar += block.surface;
+    if (std::abs(plane.normal.dot(block.point) + offset) >= epsilon_) return;
+    result.score += block.surface;
+    const Eigen::Vector3d relative = (block.point - plane.point).cast<double>();
+    if (block.vertical) {
+      // A wall of full-height blocks is a line through their mid-points: its top and
+      // bottom make the plane's normal definite.
+      const double half_depth = 0.5 * (block.top - block.bottom);
+      const double weight = 0.5 * block.surface;
+      for (const double dz : {half_depth, -half_depth}) {
+        const Eigen::Vector3d p = relative + Eigen::Vector3d(0.0, 0.0, dz);
+        result.weight += weight;
+        result.sum += weight * p;
+        result.outer += weight * p * p.transpose();
+      }
+    } else {
+      result.weight += 1.0;
+      result.sum += relative;
+      result.outer += relative * relative.transpose();
+    }
+  });
+  return result;
+}
+
+bool PlaneScorer::matches(std::uint32_t id, const CandidatePlane& plane) const {
+  if (taken_[id] != 0 || directions_[id].squaredNorm() == 0.0F) return false;
+  if (std::abs(directions_[id].dot(plane.normal)) < cos_kappa_) return false;
+  return std::abs(plane.normal.dot(grid_.blocks()[id].point - plane.point)) < epsilon_;
+}
+
+std::vector<std::uint32_t> PlaneScorer::matching(const CandidatePlane& plane) const {
+  std::vector<std::uint32_t> ids;
+  const float offset = -plane.normal.dot(plane.point);
+  forEachSimilar(plane, [&](std::uint32_t id, const PlaneBlock& block) {
+    if (std::abs(plane.normal.dot(block.point) + offset) < epsilon_) ids.push_back(id);
+  });
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+void PlaneScorer::take(std::uint32_t id) { taken_[id] = 1; }
+
+}  // namespace mlmap

@@ -1,0 +1,33 @@
+#include "mlmap/planes/point_labels.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace mlmap {
+
+std::vector<std::int32_t> labelPoints(const MLMap& map, const Scan& scan) {
+  std::vector<std::int32_t> labels(scan.size(), -1);
+  const double reach = map.cellSize();
+  const auto count = static_cast<std::int64_t>(scan.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t k = 0; k < count; ++k) {
+    const auto index = static_cast<std::size_t>(k);
+    const Point p = scan.worldPoint(index);
+    if (!p.allFinite()) continue;
+    // Out-of-range coordinates have no cell; cellOf would throw inside the parallel loop.
+    if (std::abs(p.x() / reach) > (1 << 30) || std::abs(p.y() / reach) > (1 << 30)) continue;
+    double best = std::numeric_limits<double>::infinity();
+    for (const Block& block : map.blocks(map.cellOf(p.x(), p.y()))) {
+      const double distance = p.z() > block.height ? p.z() - block.height
+                              : p.z() < block.bottom() ? block.bottom() - p.z()
+                                                       : 0.0;
+      if (distance < reach && distance < best) {
+        best = distance;
+        labels[index] = block.plane;
+      }
+    }
+  }
+  return labels;
+}
+
+}  // namespace mlmap

@@ -1,0 +1,50 @@
+// Hand-made ML maps with known planes, shared by the plane-detection tests: points
+// sampled densely on rectangles with a little noise and inserted into an MLMap.
+#pragma once
+
+#include <random>
+
+#include "mlmap/map/ml_map.hpp"
+
+namespace mlmap::test {
+
+class PlaneSceneBuilder {
+ public:
+  explicit PlaneSceneBuilder(double cell_size, double noise = 0.005, unsigned seed = 1)
+      : map_(cell_size), noise_(0.0, noise), random_(seed) {}
+
+  // Samples the parallelogram corner + s·u + t·v (s, t ∈ [0, 1]) every `spacing` m.
+  PlaneSceneBuilder& rectangle(const Eigen::Vector3d& corner, const Eigen::Vector3d& u,
+                               const Eigen::Vector3d& v, double spacing = 0.01) {
+    const int steps_u = static_cast<int>(u.norm() / spacing);
+    const int steps_v = static_cast<int>(v.norm() / spacing);
+    const Eigen::Vector3d normal = u.cross(v).normalized();
+    for (int a = 0; a <= steps_u; ++a) {
+      for (int b = 0; b <= steps_v; ++b) {
+        const Eigen::Vector3d p = corner + u * (static_cast<double>(a) / steps_u) +
+                                  v * (static_cast<double>(b) / steps_v) + normal * noise_(random_);
+        map_.insert(p, 1e-4);
+      }
+    }
+    return *this;
+  }
+  PlaneSceneBuilder& floor(double x0, double y0, double x1, double y1, double z) {
+    return rectangle({x0, y0, z}, {x1 - x0, 0, 0}, {0, y1 - y0, 0});
+  }
+  // A wall x = const from y0 to y1, z0 to z1.
+  PlaneSceneBuilder& wallX(double x, double y0, double y1, double z0, double z1) {
+    return rectangle({x, y0, z0}, {0, y1 - y0, 0}, {0, 0, z1 - z0});
+  }
+  PlaneSceneBuilder& wallY(double y, double x0, double x1, double z0, double z1) {
+    return rectangle({x0, y, z0}, {x1 - x0, 0, 0}, {0, 0, z1 - z0});
+  }
+
+  MLMap& map() { return map_; }
+
+ private:
+  MLMap map_;
+  std::normal_distribution<double> noise_;
+  std::mt19937 random_;
+};
+
+}  // namespace mlmap::test

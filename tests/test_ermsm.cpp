@@ -1,0 +1,156 @@
+// eRMSM on small hand-made maps with known planes: angle and offset errors bounded.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "mlmap/planes/ermsm.hpp"
+#include "plane_scenes.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * 180.0 / M_PI;
+}
+
+// The detected plane closest to n·x + offset = 0 (unsigned normal).
+const Plane* findPlane(const PlaneDetection& detection, const Eigen::Vector3d& normal, double offset) {
+  const Plane* best = nullptr;
+  double best_error = 1e9;
+  for (const Plane& plane : detection.planes) {
+    const double sign = plane.normal.dot(normal) < 0 ? -1.0 : 1.0;
+    const double error = angleDeg(plane.normal, normal) / 10.0 + std::abs(sign * plane.offset - offset);
+    if (error < best_error) {
+      best_error = error;
+      best = &plane;
+    }
+  }
+  return best;
+}
+
+std::size_t labelledBlocks(const MLMap& map) {
+  std::size_t count = 0;
+  for (std::size_t n = 0; n < map.cellCount(); ++n) {
+    for (const Block& block : map.blocksAt(n)) count += block.plane != 0 ? 1 : 0;
+  }
+  return count;
+}
+
+}  // namespace
+
+TEST_CASE("eRMSM: a single wall off the grid is one plane, normal within 1 degree") {
+  test::PlaneSceneBuilder scene(0.05);
+  scene.wallX(1.03, 0.0, 3.0, 0.0, 2.5);
+  const PlaneDetection detection = detectPlanes(scene.map());
+  REQUIRE(detection.planes.size() == 1);
+  const Plane& wall = detection.planes[0];
+  CHECK(angleDeg(wall.normal, Eigen::Vector3d::UnitX()) < 1.0);
+  // Block points sit at cell centres: the offset is good to half a cell.
+  CHECK(std::abs(std::abs(wall.offset) - 1.03) <= 0.5 * 0.05 + 0.005);
+  CHECK(wall.label == PlaneClass::Wall);
+  CHECK(wall.area == doctest::Approx(3.0 * 2.5).epsilon(0.1));
+  CHECK(labelledBlocks(scene.map()) == wall.block_count);
+  CHECK(wall.outline.size() >= 4);
+}
+
+TEST_CASE("eRMSM: a floor with a table gives two planes, floor and table, offsets within 1 cm") {
+  test::PlaneSceneBuilder scene(0.05);
+  scene.floor(0.0, 0.0, 4.0, 4.0, 0.0).floor(1.0, 1.0, 2.2, 1.8, 0.75);
+  const PlaneDetection detection = detectPlanes(scene.map());
+  REQUIRE(detection.planes.size() == 2);
+  const Plane* floor = findPlane(detection, Eigen::Vector3d::UnitZ(), 0.0);
+  const Plane* table = findPlane(detection, Eigen::Vector3d::UnitZ(), -0.75);
+  REQUIRE(floor != nullptr);
+  REQUIRE(table != nullptr);
+  REQUIRE(floor != table);
+  CHECK(floor->label == PlaneClass::Floor);
+  CHECK(table->label == PlaneClass::Table);
+  CHECK(angleDeg(floor->normal, Eigen::Vector3d::UnitZ()) < 1.0);
+  CHECK(angleDeg(table->normal, Eigen::Vector3d::UnitZ()) < 1.0);
+  CHECK(std::abs(floor->offset) < 0.01);
+  CHECK(std::abs(table->offset + 0.75) < 0.01);
+  CHECK(table->area == doctest::Approx(1.2 * 0.8).epsilon(0.2));
+}
+
+TEST_CASE("eRMSM: two tables at one height are two patches of one plane") {
+  test::PlaneSceneBuilder scene(0.05);
+  scene.floor(0.0, 0.0, 5.0, 3.0, 0.0).floor(0.5, 0.5, 1.7, 1.3, 0.75).floor(3.0, 1.5, 4.2, 2.3, 0.75);
+  const PlaneDetection detection = detectPlanes(scene.map());
+  REQUIRE(detection.planes.size() == 3);
+  int tables = 0;
+  for (const Plane& plane : detection.planes) tables += plane.label == PlaneClass::Table ? 1 : 0;
+  CHECK(tables == 2);
+  const auto tops = std::count_if(detection.planes.begin(), detection.planes.end(),
+                                  [](const Plane& p) { return std::abs(p.centroid.z() - 0.75) < 0.02; });
+  CHECK(tops == 2);
+}
+
+TEST_CASE("eRMSM: two parallel walls are two planes with their own offsets") {
+  test::PlaneSceneBuilder scene(0.05);
+  scene.wallY(0.02, 0.0, 4.0, 0.0, 2.5).wallY(2.98, 0.0, 4.0, 0.0, 2.5);
+  const PlaneDetection detection = detectPlanes(scene.map());
+  REQUIRE(detection.planes.size() == 2);
+  const Plane* near_wall = findPlane(detection, Eigen::Vector3d::UnitY(), -0.02);
+  const Plane* far_wall = findPlane(detection, Eigen::Vector3d::UnitY(), -2.98);
+  REQUIRE(near_wall != far_wall);
+  CHECK(angleDeg(near_wall->normal, Eigen::Vector3d::UnitY()) < 1.0);
+  CHECK(angleDeg(far_wall->normal, Eigen::Vector3d::UnitY()) < 1.0);
+  CHECK(std::abs(std::abs(near_wall->offset) - 0.02) <= 0.03);
+  CHECK(std::abs(std::abs(far_wall->offset) - 2.98) <= 0.03);
+}
+
+TEST_CASE("eRMSM: a staircase's treads are steps, each at its height within 1 cm") {
+  test::PlaneSceneBuilder scene(0.05);
+  constexpr double kRiser = 0.17;
+  constexpr double kTread = 0.3;
+  scene.floor(-2.0, -1.0, 0.0, 2.0, 0.0);
+  for (int step = 0; step < 4; ++step) {
+    const double x = step * kTread;
+    scene.floor(x, 0.0, x + kTread, 1.0, (step + 1) * kRiser);                  // tread
+    scene.rectangle({x, 0.0, step * kRiser}, {0, 1.0, 0}, {0, 0, kRiser});      // riser
+  }
+  const PlaneDetection detection = detectPlanes(scene.map());
+  for (int step = 1; step <= 4; ++step) {
+    const Plane* tread = findPlane(detection, Eigen::Vector3d::UnitZ(), -step * kRiser);
+    REQUIRE(tread != nullptr);
+    CAPTURE(step);
+    CHECK(std::abs(std::abs(tread->offset) - step * kRiser) < 0.01);
+    CHECK(angleDeg(tread->normal, Eigen::Vector3d::UnitZ()) < 2.0);
+    CHECK(tread->label == PlaneClass::Step);
+  }
+  const Plane* floor = findPlane(detection, Eigen::Vector3d::UnitZ(), 0.0);
+  CHECK(floor->label == PlaneClass::Floor);
+}
+
+TEST_CASE("eRMSM: the same seed gives the same planes at 1 and 2 threads") {
+  auto run = [](int threads, std::uint64_t seed) {
+    test::PlaneSceneBuilder scene(0.05, 0.005, 4);
+    scene.floor(0.0, 0.0, 4.0, 3.0, 0.0).wallX(0.0, 0.0, 3.0, 0.0, 2.5).wallY(3.0, 0.0, 4.0, 0.0, 2.5);
+    scene.floor(1.0, 1.0, 2.0, 1.6, 0.72);
+    ErmsmConfig config;
+    config.threads = threads;
+    config.seed = seed;
+    return detectPlanes(scene.map(), config);
+  };
+  const PlaneDetection one = run(1, 7);
+  const PlaneDetection two = run(2, 7);
+  REQUIRE(one.planes.size() == two.planes.size());
+  CHECK(one.stats.candidates == two.stats.candidates);
+  for (std::size_t k = 0; k < one.planes.size(); ++k) {
+    CHECK(one.planes[k].normal == two.planes[k].normal);
+    CHECK(one.planes[k].offset == two.planes[k].offset);
+    CHECK(one.planes[k].block_count == two.planes[k].block_count);
+  }
+  CHECK(one.planes.size() == 4);
+}
+
+TEST_CASE("eRMSM: an empty or tiny map gives no planes and no crash") {
+  MLMap empty(0.1);
+  CHECK(detectPlanes(empty).planes.empty());
+  MLMap tiny(0.1);
+  tiny.insert(Point(0.05, 0.05, 0.0), 1e-4);
+  tiny.insert(Point(0.15, 0.05, 0.0), 1e-4);
+  CHECK(detectPlanes(tiny).planes.empty());
+}
