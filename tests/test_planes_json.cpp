@@ -1,0 +1,66 @@
+// The planes JSON export against web/planes.schema.json, and its content.
+#include <doctest/doctest.h>
+
+#include <fstream>
+#include <set>
+
+#include "mlmap/error.hpp"
+
+#include "helpers.hpp"
+#include "json_schema.hpp"
+#include "mlmap/io/planes_json.hpp"
+#include "plane_scenes.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+test::JsonSchema planesSchema() {
+  std::ifstream in(test::sourceDir() / "web" / "planes.schema.json");
+  return test::JsonSchema(nlohmann::json::parse(in));
+}
+
+}  // namespace
+
+TEST_CASE("PlanesJson: an export of a room validates against the schema and says what was found") {
+  test::PlaneSceneBuilder scene(0.05);
+  scene.floor(0.0, 0.0, 4.0, 3.0, 0.0).floor(0.0, 0.0, 4.0, 3.0, 2.6).wallX(0.0, 0.0, 3.0, 0.0, 2.6);
+  scene.floor(1.0, 1.0, 2.2, 1.8, 0.75);
+  Map map(MapConfig{0.05, 0.0, -1.0, false});
+  map.blocks() = scene.map();
+  const PlaneDetection detection = detectPlanes(map.blocks());
+  const nlohmann::json json = nlohmann::json::parse(io::planesJson(map, detection, "room.mlmap"));
+  const auto error = planesSchema().check(json);
+  CHECK_MESSAGE(!error.has_value(), error.value_or(""));
+  CHECK(json["schema"] == "mlmap.planes/1");
+  REQUIRE(json["planes"].size() == detection.planes.size());
+  std::set<std::string> labels;
+  for (const auto& plane : json["planes"]) labels.insert(plane["label"].get<std::string>());
+  CHECK(labels == std::set<std::string>{"floor", "ceiling", "wall", "table"});
+  CHECK(json["map"]["cell_size"] == 0.05);
+  CHECK(json["parameters"]["seed"] == 1);
+}
+
+TEST_CASE("PlanesJson: the schema checker catches what a broken export would have") {
+  const test::JsonSchema schema = planesSchema();
+  nlohmann::json json = {{"schema", "mlmap.planes/2"}};
+  CHECK(schema.check(json).has_value());
+  test::PlaneSceneBuilder scene(0.05);
+  scene.floor(0.0, 0.0, 3.0, 3.0, 0.0);
+  Map map(MapConfig{0.05, 0.0, -1.0, false});
+  map.blocks() = scene.map();
+  json = nlohmann::json::parse(io::planesJson(map, detectPlanes(map.blocks()), "floor.mlmap"));
+  REQUIRE_FALSE(schema.check(json).has_value());
+  json["planes"][0]["label"] = "roof";
+  CHECK(schema.check(json).value_or("").find("roof") != std::string::npos);
+  json["planes"][0]["label"] = "floor";
+  json["planes"][0]["normal"] = {0.0, 1.0};
+  CHECK(schema.check(json).value_or("").find("normal") != std::string::npos);
+}
+
+TEST_CASE("PlanesJson: a failed write leaves no file") {
+  test::TempDir dir;
+  Map map(MapConfig{0.1, 0.0, -1.0, false});
+  CHECK_THROWS_AS(io::writePlanesJson(dir / "missing" / "p.json", map, detectPlanes(map.blocks()), "m"), Error);
+  CHECK(std::filesystem::is_empty(dir.path()));
+}
