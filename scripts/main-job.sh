@@ -14,3 +14,4 @@ mlmap=build/mlmap
 "$mlmap" build -o "$out/map.mlmap" --poses "$out/poses_true.txt" --cell-size 0.05 --range-sigma 0.01 \
   "$out"/scan_*.xyz
 "$mlmap" info "$out/map.mlmap"
+"$mlmap" planes "$out/map.mlmap" --json "$out/planes.json" -o "$out/labelled.mlmap"
