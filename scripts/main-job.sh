@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The main job on the scenes that ship in maps/: install, build, simulate the lab,
-# build its ML map from the scans and poses, and print what the map holds.
+# build its ML map from the scans and poses, print what it holds and detect its planes.
 # Usage: scripts/main-job.sh [SCENE.json] [OUT_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
