@@ -57,6 +57,9 @@ void addPlanesCommand(CLI::App& app, Context& context) {
   command->add_option("--kappa", config.kappa_deg, "κ: max angle block direction / plane normal, deg")->capture_default_str();
   command->add_option("--theta", config.theta_deg, "θ: max angle between the seeds' directions, deg")->capture_default_str();
   command->add_option("--probability", config.min_probability, "p_t: acceptance probability (eq. 10)")->capture_default_str();
+  command->add_option("--acceptance-exponent", config.acceptance_exponent,
+                      "k of eq. 10, P = (s_c/s_o)^k: the paper's 3, or 1 (default: only the first seed is drawn from the whole map)")
+      ->capture_default_str();
   command->add_option("--min-area", config.min_area, "s_m: minimal plane surface, m²")->capture_default_str();
   command->add_option("--min-patch-area", config.min_patch_area, "Smaller connected patches are dropped, m²")->capture_default_str();
   command->add_option("--max-candidates", config.max_candidates, "Max_cp: candidates in all")->capture_default_str();

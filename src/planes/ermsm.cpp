@@ -68,6 +68,8 @@ class Detector {
   std::vector<Plane> run(ErmsmStats& stats);
   // The patch id of every block (0 for none), by block id.
   const std::vector<std::int32_t>& labels() const { return labels_; }
+  // After classification: one patch per floor and per ceiling.
+  std::vector<Plane> mergeLevels(const std::vector<Plane>& planes);
 
  private:
   void rebuildSeedable();
@@ -78,7 +80,9 @@ class Detector {
   std::vector<std::uint32_t> withEdges(std::vector<std::uint32_t> matching, const CandidatePlane& plane) const;
   Plane describePatch(const Patch& patch, const CandidatePlane& reference) const;
   std::vector<Plane> mergeCoplanar(const std::vector<Plane>& planes);
+  std::vector<Plane> mergeGroups(const std::vector<Plane>& planes, const std::vector<std::size_t>& roots);
   double directionSpread(const std::vector<std::uint32_t>& ids, const CandidatePlane& plane) const;
+  bool isThin(const Patch& patch, const CandidatePlane& plane) const;
 
   const BlockGrid& grid_;
   const std::vector<Eigen::Vector3f>& directions_;
@@ -288,6 +292,35 @@ std::vector<std::uint32_t> Detector::withEdges(std::vector<std::uint32_t> matchi
   return matching;
 }
 
+// A patch one cell wide is no surface: it is the fringe of a wall standing on a cell
+// boundary (stray points in the next column) or a line of clutter. Its blocks must
+// spread across the plane in both directions.
+bool Detector::isThin(const Patch& patch, const CandidatePlane& plane) const {
+  Eigen::Vector3d u = Eigen::Vector3d::UnitZ().cross(plane.normal.cast<double>());
+  if (u.norm() < 0.3) u = plane.normal.cast<double>().cross(Eigen::Vector3d::UnitX());
+  u.normalize();
+  const Eigen::Vector3d v = plane.normal.cast<double>().cross(u).normalized();
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d outer = Eigen::Matrix2d::Zero();
+  double weight = 0.0;
+  for (const std::uint32_t id : patch.blocks) {
+    const PlaneBlock& block = grid_.blocks()[id];
+    const Eigen::Vector3d relative = block.point.cast<double>() - plane.point.cast<double>();
+    const double half = block.vertical ? 0.5 * (block.top - block.bottom) : 0.0;
+    for (const double dz : {half, -half}) {
+      const Eigen::Vector3d p = relative + Eigen::Vector3d(0.0, 0.0, dz);
+      const Eigen::Vector2d q(p.dot(u), p.dot(v));
+      sum += q;
+      outer += q * q.transpose();
+      weight += 1.0;
+    }
+  }
+  const Eigen::Vector2d mean = sum / weight;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(outer / weight - mean * mean.transpose());
+  const double minor = std::sqrt(std::max(0.0, solver.eigenvalues()(0)));
+  return minor < config_.min_patch_width_cells * grid_.cellSize();
+}
+
 double Detector::directionSpread(const std::vector<std::uint32_t>& ids, const CandidatePlane& plane) const {
   double weighted = 0.0;
   double weight = 0.0;
@@ -311,6 +344,8 @@ std::vector<Plane> Detector::mergeCoplanar(const std::vector<Plane>& planes) {
     return k;
   };
   const double cos_parallel = std::cos(0.5 * radians(config_.kappa_deg));
+  // Pieces closer than a table leg's width are one surface.
+  const int touch_radius = std::max(2, static_cast<int>(std::ceil(0.3 / grid_.cellSize())));
   for (std::size_t a = 0; a < count; ++a) {
     for (std::size_t b = a + 1; b < count; ++b) {
       const Plane& first = planes[a];
@@ -322,7 +357,7 @@ std::vector<Plane> Detector::mergeCoplanar(const std::vector<Plane>& planes) {
       }
       bool touching = false;
       for (const std::uint32_t id : plane_blocks_[a]) {
-        grid_.forEachNeighbour(grid_.blocks()[id].cell, 2, [&](std::uint32_t other) {
+        grid_.forEachNeighbour(grid_.blocks()[id].cell, touch_radius, [&](std::uint32_t other) {
           if (labels_[other] == second.id) touching = true;
         });
         if (touching) break;
@@ -330,6 +365,33 @@ std::vector<Plane> Detector::mergeCoplanar(const std::vector<Plane>& planes) {
       if (touching) group[root(b)] = root(a);
     }
   }
+  std::vector<std::size_t> roots(count);
+  for (std::size_t k = 0; k < count; ++k) roots[k] = root(k);
+  return mergeGroups(planes, roots);
+}
+
+// Floor and ceiling patches are one level each, however far apart (a floor seen
+// between furniture, a ceiling either side of a beam): one patch per class.
+std::vector<Plane> Detector::mergeLevels(const std::vector<Plane>& planes) {
+  std::vector<std::size_t> roots(planes.size());
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    roots[k] = k;
+    if (planes[k].label != PlaneClass::Floor && planes[k].label != PlaneClass::Ceiling) continue;
+    for (std::size_t first = 0; first < k; ++first) {
+      if (planes[first].label == planes[k].label) {
+        roots[k] = first;
+        break;
+      }
+    }
+  }
+  return mergeGroups(planes, roots);
+}
+
+// Merges the planes that share a root (the root's index is the smallest of its
+// group); ids are renumbered in order and the block labels follow.
+std::vector<Plane> Detector::mergeGroups(const std::vector<Plane>& planes, const std::vector<std::size_t>& roots) {
+  const std::size_t count = planes.size();
+  auto root = [&](std::size_t k) { return roots[k]; };
   std::vector<Plane> merged;
   std::vector<std::int32_t> new_id(count, 0);
   for (std::size_t k = 0; k < count; ++k) {
@@ -354,8 +416,16 @@ std::vector<Plane> Detector::mergeCoplanar(const std::vector<Plane>& planes) {
     for (std::size_t member = 0; member < count; ++member) {
       if (root(member) == head) new_id[member] = plane.id;
     }
+    plane.label = largest.label;
     merged.push_back(std::move(plane));
   }
+  std::vector<std::vector<std::uint32_t>> merged_blocks(merged.size());
+  for (std::size_t k = 0; k < count; ++k) {
+    auto& blocks = merged_blocks[static_cast<std::size_t>(new_id[k] - 1)];
+    blocks.insert(blocks.end(), plane_blocks_[k].begin(), plane_blocks_[k].end());
+  }
+  for (auto& blocks : merged_blocks) std::sort(blocks.begin(), blocks.end());
+  plane_blocks_ = std::move(merged_blocks);
   for (std::int32_t& label : labels_) {
     if (label > 0) label = new_id[static_cast<std::size_t>(label - 1)];
   }
@@ -382,7 +452,8 @@ bool Detector::accept(std::size_t index, std::vector<Plane>& planes) {
   bool kept = false;
   for (const Patch& patch : patches) {
     if (patch.surface * cell_area < config_.min_patch_area ||
-        patch.blocks.size() < static_cast<std::size_t>(config_.min_patch_blocks)) {
+        patch.blocks.size() < static_cast<std::size_t>(config_.min_patch_blocks) ||
+        isThin(patch, accepted.plane)) {
       continue;
     }
     Plane plane = describePatch(patch, accepted.plane);
@@ -458,7 +529,7 @@ std::vector<Plane> Detector::run(ErmsmStats& stats) {
       std::size_t listed = unlisted_;
       for (const Candidate& candidate : candidates_) listed += static_cast<std::size_t>(candidate.multiplicity);
       const double ratio = std::min(1.0, leader.score.score / std::max(leader.score.similar, 1e-9));
-      const double probability = 1.0 - std::pow(1.0 - ratio * ratio * ratio, static_cast<double>(listed));  // eq. 6, 10
+      const double probability = 1.0 - std::pow(1.0 - std::pow(ratio, config_.acceptance_exponent), static_cast<double>(listed));  // eq. 6, 10
       if (probability < config_.min_probability) break;
       accept(*best, planes);
       if (seedable_.size() < 3) break;
@@ -498,6 +569,7 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   stats.detection_seconds = secondsSince(start);
 
   classifyPlanes(detection.planes);
+  detection.planes = detector.mergeLevels(detection.planes);
   const std::vector<std::int32_t>& labels = detector.labels();
   for (std::size_t n = 0; n < map.cellCount(); ++n) {
     const auto blocks = map.mutableBlocksAt(n);

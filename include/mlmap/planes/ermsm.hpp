@@ -18,9 +18,15 @@ struct ErmsmConfig {
   double kappa_deg = 25.0;        // deg, max angle between a block's direction and the plane, κ
   double theta_deg = 15.0;        // deg, max angle between the three seeds' directions, θ
   double min_probability = 0.99;  // p_t of eq. 10's acceptance test
+  // k in eq. 10's P = (s_c / s_o)^k. The paper cubes the ratio, as if all three seeds
+  // were drawn from the whole map; here only the first is, the other two are its
+  // neighbours, so one power counts the draw. With 3, planes of a few percent of
+  // their orientation's surface (stair treads, risers) are never accepted.
+  double acceptance_exponent = 1.0;
   double min_area = 0.15;         // m², s_m: a plane's minimal matched surface
   double min_patch_area = 0.1;    // m², smaller connected patches go back to the pool
   int min_patch_blocks = 6;       // blocks, and so do patches of fewer blocks
+  double min_patch_width_cells = 0.7;  // cells, and patches whose blocks spread less across (std-dev)
   double max_direction_spread_deg = 10.0;  // deg, mean angle of a plane's blocks to its normal (curved surfaces fail)
   int max_candidates = 4000;      // Max_cp: Algorithm 1 stops after this many candidates
   int max_idle_candidates = 1000; // ... or after this many without an accepted plane
