@@ -1,0 +1,107 @@
+// An emulator of the scanner of section III, so the real driver code runs end to end
+// without hardware: a Hokuyo UTM-30LX speaking SCIP 2.0 and a PTU-46-17.5 speaking the
+// Directed Perception protocol, each on a pseudo-terminal (the laser optionally on a
+// loopback TCP port instead). The laser ray-casts a scene (sim/scene.hpp) once per
+// 25 ms revolution at the tilt the PTU's trapezoidal profile gives at each step's time;
+// both devices share one emulated clock that may run faster than real time, so protocol
+// timestamps stay consistent at any time scale. Faults can be injected.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "mlmap/driver/kinematics.hpp"
+#include "mlmap/driver/transport.hpp"
+#include "mlmap/scan.hpp"
+#include "mlmap/sim/ray_caster.hpp"
+#include "mlmap/sim/scene.hpp"
+
+namespace mlmap::driver {
+
+struct EmulatorFaults {
+  int bad_checksum_frame = -1;  // MD/MS data frame (0-based) whose data line gets a wrong sum
+  int dropped_line_frame = -1;  // data frame that loses one data line
+  int stall_after_frames = -1;  // laser goes silent after this many data frames
+  int disconnect_after_frames = -1;  // laser hangs up after this many data frames
+};
+
+struct EmulatorOptions {
+  double time_scale = 1.0;          // emulated seconds per real second
+  double range_sigma = 0.01;        // m, Gaussian range noise
+  std::uint64_t seed = 1;
+  std::uint32_t clock_start_ms = 0;  // laser clock at start (near 2^24 to test the wrap)
+  MountConfig mount;
+  Pose base_pose = Pose::Identity();  // pan-tilt base frame -> scene (world) frame
+  bool laser_over_tcp = false;       // laser on a loopback TCP port instead of a pty
+  int tcp_port = 0;                  // 0: any free port
+  EmulatorFaults faults;
+};
+
+class Emulator {
+ public:
+  Emulator(const sim::Scene& scene, const EmulatorOptions& options);
+  ~Emulator();
+  Emulator(const Emulator&) = delete;
+  Emulator& operator=(const Emulator&) = delete;
+
+  const std::string& laserPath() const { return laser_path_; }  // pty slave (empty over TCP)
+  int laserTcpPort() const;                                       // 0 unless over TCP
+  const std::string& ptuPath() const { return ptu_path_; }
+  void setBasePose(const Pose& pose);  // for the next revolutions (move-and-stop)
+  // s on the laser's (unwrapped) clock when the last tilt move began; nullopt before one.
+  std::optional<double> lastTiltMoveStart() const;
+  std::size_t framesSent() const { return frames_sent_.load(); }
+  void stop();
+
+  // Units of the emulated PTU (a PTU-46-17.5).
+  static constexpr double kResolutionArcsec = 185.1428;
+  static constexpr int kTiltMin = -907, kTiltMax = 604, kPanMin = -3090, kPanMax = 3090;
+
+ private:
+  struct Move {
+    double start_s;      // emulated
+    double from_deg, to_deg, speed, base, accel;
+  };
+  struct Axis {
+    std::vector<Move> history;
+    int speed = 1000, base = 100, accel = 2000, upper = 2900;  // positions/s, /s²
+    int min = 0, max = 0;
+    int target = 0;
+  };
+
+  double emulatedSeconds() const;
+  double axisDeg(const Axis& axis, double t) const;
+  void laserLoop();
+  void ptuLoop();
+  std::string handleScip(const std::string& command);
+  std::string scanFrame(const std::string& echo, const std::string& status, std::uint64_t revolution,
+                        std::uint32_t start, std::uint32_t end, std::uint32_t cluster, int width,
+                        int frame_index);
+  std::string handlePtu(const std::string& command, bool& deferred_await);
+  bool ptuIdle(double t) const;
+
+  sim::Scene scene_;
+  EmulatorOptions options_;
+  std::unique_ptr<sim::RayCaster> caster_;
+  std::unique_ptr<FdTransport> laser_, ptu_;
+  std::unique_ptr<TcpListener> listener_;
+  int laser_slave_hold_ = -1, ptu_slave_hold_ = -1;
+  std::string laser_path_, ptu_path_;
+  std::chrono::steady_clock::time_point start_;
+  mutable std::mutex mutex_;  // guards pan_, tilt_, base_pose_ (laser reads, PTU writes)
+  Axis pan_, tilt_;
+  Pose base_pose_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::size_t> frames_sent_{0};
+  // laser state (laser thread only)
+  bool laser_on_ = false, time_adjust_ = false, echo_ptu_ = true, terse_ = false, slaved_ = false;
+  std::thread laser_thread_, ptu_thread_;
+};
+
+}  // namespace mlmap::driver
