@@ -112,38 +112,60 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
   Eigen::Vector3d v_axis;
   planeBasis(normal, u_axis, v_axis);
   const double cell = grid.cellSize();
-  std::unordered_map<GridCell, std::size_t, GridCellHash> cell_number;
-  std::vector<GridCell> cells;
-  std::vector<std::size_t> first_cell_of_block(blocks.size());
-  auto addCell = [&](const Eigen::Vector3d& p) {
+  // Every block's grid cells on the plane (a vertical block covers its height).
+  std::vector<GridCell> block_cells;
+  std::vector<std::size_t> first_cell_of_block(blocks.size() + 1);
+  auto cellOf = [&](const Eigen::Vector3d& p) {
     const Eigen::Vector3d relative = p - point;
-    const GridCell cell_key{static_cast<std::int32_t>(std::floor(relative.dot(u_axis) / cell)),
-                            static_cast<std::int32_t>(std::floor(relative.dot(v_axis) / cell))};
-    const auto [entry, inserted] = cell_number.emplace(cell_key, cells.size());
-    if (inserted) cells.push_back(cell_key);
-    return entry->second;
+    return GridCell{static_cast<std::int32_t>(std::floor(relative.dot(u_axis) / cell)),
+                    static_cast<std::int32_t>(std::floor(relative.dot(v_axis) / cell))};
   };
   for (std::size_t k = 0; k < blocks.size(); ++k) {
+    first_cell_of_block[k] = block_cells.size();
     const PlaneBlock& block = grid.blocks()[blocks[k]];
     const Eigen::Vector3d centre = block.point.cast<double>();
-    if (!block.vertical) {
-      first_cell_of_block[k] = addCell(centre);
-      continue;
-    }
-    // A vertical block covers its height: rasterise it in steps of a cell.
+    block_cells.push_back(cellOf(centre));
+    if (!block.vertical) continue;
     const double depth = block.top - block.bottom;
     const int steps = std::max(1, static_cast<int>(std::ceil(depth / cell)));
-    first_cell_of_block[k] = addCell(centre);
     for (int s = 0; s <= steps; ++s) {
-      addCell(Eigen::Vector3d(centre.x(), centre.y(), block.bottom + depth * s / steps));
+      block_cells.push_back(cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.bottom + depth * s / steps)));
     }
+  }
+  first_cell_of_block[blocks.size()] = block_cells.size();
+  // A dense raster over the cells' bounding box (with a margin for the gap): planes
+  // in a building are compact, and lookups in an array beat a hash map by far.
+  std::int32_t min_u = block_cells[0].u, max_u = min_u, min_v = block_cells[0].v, max_v = min_v;
+  for (const GridCell& c : block_cells) {
+    min_u = std::min(min_u, c.u);
+    max_u = std::max(max_u, c.u);
+    min_v = std::min(min_v, c.v);
+    max_v = std::max(max_v, c.v);
+  }
+  const std::int64_t columns = static_cast<std::int64_t>(max_u) - min_u + 1 + 2 * gap_cells;
+  const std::int64_t rows = static_cast<std::int64_t>(max_v) - min_v + 1 + 2 * gap_cells;
+  std::vector<std::int32_t> raster(static_cast<std::size_t>(columns * rows), -1);
+  auto at = [&](std::int64_t u, std::int64_t v) -> std::int32_t& {
+    return raster[static_cast<std::size_t>((v - min_v + gap_cells) * columns + (u - min_u + gap_cells))];
+  };
+  std::vector<GridCell> cells;  // distinct occupied cells
+  std::vector<std::size_t> cell_of(block_cells.size());
+  for (std::size_t n = 0; n < block_cells.size(); ++n) {
+    std::int32_t& slot = at(block_cells[n].u, block_cells[n].v);
+    if (slot < 0) {
+      slot = static_cast<std::int32_t>(cells.size());
+      cells.push_back(block_cells[n]);
+    }
+    cell_of[n] = static_cast<std::size_t>(slot);
   }
   DisjointSets sets(cells.size());
   for (std::size_t n = 0; n < cells.size(); ++n) {
-    for (int du = -gap_cells; du <= gap_cells; ++du) {
-      for (int dv = -gap_cells; dv <= gap_cells; ++dv) {
-        const auto other = cell_number.find(GridCell{cells[n].u + du, cells[n].v + dv});
-        if (other != cell_number.end()) sets.unite(n, other->second);
+    // Half the neighbourhood suffices: the other half links back to this cell.
+    for (int dv = 0; dv <= gap_cells; ++dv) {
+      for (int du = -gap_cells; du <= gap_cells; ++du) {
+        if (dv == 0 && du <= 0) continue;
+        const std::int32_t other = at(cells[n].u + du, cells[n].v + dv);
+        if (other >= 0) sets.unite(n, static_cast<std::size_t>(other));
       }
     }
   }
@@ -153,7 +175,7 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
   std::map<std::size_t, std::vector<GridCell>> cells_by_root;
   for (std::size_t n = 0; n < cells.size(); ++n) cells_by_root[sets.find(n)].push_back(cells[n]);
   for (std::size_t k = 0; k < blocks.size(); ++k) {
-    Patch& patch = by_root[sets.find(first_cell_of_block[k])];
+    Patch& patch = by_root[sets.find(cell_of[first_cell_of_block[k]])];
     patch.blocks.push_back(blocks[k]);
     patch.surface += grid.blocks()[blocks[k]].surface;
   }

@@ -1,6 +1,8 @@
 #include "plane_scorer.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 
 namespace mlmap {
@@ -42,20 +44,31 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
                           static_cast<float>(std::sin(elevation)));
     }
   }
+  slot_.assign(grid.size(), {UINT32_MAX, 0});
   for (std::uint32_t id = 0; id < grid.size(); ++id) {
-    if (directions[id].squaredNorm() > 0.0F) bins_[static_cast<std::size_t>(binOf(directions[id]))].ids.push_back(id);
+    if (directions[id].squaredNorm() == 0.0F) continue;
+    const auto bin_number = static_cast<std::uint32_t>(binOf(directions[id]));
+    Bin& bin = bins_[bin_number];
+    const PlaneBlock& block = grid.blocks()[id];
+    slot_[id] = {bin_number, static_cast<std::uint32_t>(bin.ids.size())};
+    bin.ids.push_back(id);
+    bin.points.push_back(block.point);
+    bin.directions.push_back(directions[id]);
+    bin.surfaces.push_back(block.surface);
+    bin.half_depths.push_back(block.vertical ? 0.5F * (block.top - block.bottom) : 0.0F);
+    bin.taken.push_back(0);
   }
 }
 
 template <typename Visit>
 void PlaneScorer::forEachSimilar(const CandidatePlane& plane, Visit&& visit) const {
-  const auto& blocks = grid_.blocks();
   for (const Bin& bin : bins_) {
     if (bin.ids.empty() || std::abs(bin.axis.dot(plane.normal)) < cos_bin_reach_) continue;
-    for (const std::uint32_t id : bin.ids) {
-      if (taken_[id] != 0) continue;
-      if (std::abs(directions_[id].dot(plane.normal)) < cos_kappa_) continue;
-      visit(id, blocks[id]);
+    const std::size_t count = bin.ids.size();
+    for (std::size_t k = 0; k < count; ++k) {
+      if (bin.taken[k] != 0) continue;
+      if (std::abs(bin.directions[k].dot(plane.normal)) < cos_kappa_) continue;
+      visit(bin, k);
     }
   }
 }
@@ -63,16 +76,17 @@ void PlaneScorer::forEachSimilar(const CandidatePlane& plane, Visit&& visit) con
 PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
   PlaneScore result;
   const float offset = -plane.normal.dot(plane.point);
-  forEachSimilar(plane, [&](std::uint32_t, const PlaneBlock& block) {
-    result.similar += block.surface;
-    if (std::abs(plane.normal.dot(block.point) + offset) >= epsilon_) return;
-    result.score += block.surface;
-    const Eigen::Vector3d relative = (block.point - plane.point).cast<double>();
-    if (block.vertical) {
+  forEachSimilar(plane, [&](const Bin& bin, std::size_t k) {
+    const float surface = bin.surfaces[k];
+    result.similar += surface;
+    if (std::abs(plane.normal.dot(bin.points[k]) + offset) >= epsilon_) return;
+    result.score += surface;
+    const Eigen::Vector3d relative = (bin.points[k] - plane.point).cast<double>();
+    if (bin.half_depths[k] > 0.0F) {
       // A wall of full-height blocks is a line through their mid-points: its top and
       // bottom make the plane's normal definite.
-      const double half_depth = 0.5 * (block.top - block.bottom);
-      const double weight = 0.5 * block.surface;
+      const double half_depth = bin.half_depths[k];
+      const double weight = 0.5 * surface;
       for (const double dz : {half_depth, -half_depth}) {
         const Eigen::Vector3d p = relative + Eigen::Vector3d(0.0, 0.0, dz);
         result.weight += weight;
@@ -97,13 +111,17 @@ bool PlaneScorer::matches(std::uint32_t id, const CandidatePlane& plane) const {
 std::vector<std::uint32_t> PlaneScorer::matching(const CandidatePlane& plane) const {
   std::vector<std::uint32_t> ids;
   const float offset = -plane.normal.dot(plane.point);
-  forEachSimilar(plane, [&](std::uint32_t id, const PlaneBlock& block) {
-    if (std::abs(plane.normal.dot(block.point) + offset) < epsilon_) ids.push_back(id);
+  forEachSimilar(plane, [&](const Bin& bin, std::size_t k) {
+    if (std::abs(plane.normal.dot(bin.points[k]) + offset) < epsilon_) ids.push_back(bin.ids[k]);
   });
   std::sort(ids.begin(), ids.end());
   return ids;
 }
 
-void PlaneScorer::take(std::uint32_t id) { taken_[id] = 1; }
+void PlaneScorer::take(std::uint32_t id) {
+  taken_[id] = 1;
+  const auto [bin, index] = slot_[id];
+  if (bin != UINT32_MAX) bins_[bin].taken[index] = 1;
+}
 
 }  // namespace mlmap

@@ -40,9 +40,16 @@ class PlaneScorer {
   bool taken(std::uint32_t id) const { return taken_[id] != 0; }
 
  private:
+  // A bin's blocks side by side in memory (structure of arrays), so a score pass
+  // streams through them instead of hopping around the block table.
   struct Bin {
     Eigen::Vector3f axis;  // unit centre of the bin
     std::vector<std::uint32_t> ids;
+    std::vector<Eigen::Vector3f> points;
+    std::vector<Eigen::Vector3f> directions;
+    std::vector<float> surfaces;
+    std::vector<float> half_depths;  // 0 for horizontal blocks
+    std::vector<std::uint8_t> taken;
   };
   template <typename Visit>
   void forEachSimilar(const CandidatePlane& plane, Visit&& visit) const;
@@ -54,6 +61,7 @@ class PlaneScorer {
   float cos_bin_reach_;
   std::vector<Bin> bins_;
   std::vector<std::uint8_t> taken_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> slot_;  // block id -> (bin, index)
 };
 
 }  // namespace mlmap
