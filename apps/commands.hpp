@@ -17,6 +17,7 @@ void addBuildCommand(CLI::App& app, Context& context);
 void addInfoCommand(CLI::App& app, Context& context);
 void addSimulateCommand(CLI::App& app, Context& context);
 void addRegisterCommand(CLI::App& app, Context& context);
+void addRegisterCommand(CLI::App& app, Context& context);
 void addPlanesCommand(CLI::App& app, Context& context);
 void addLabelCommand(CLI::App& app, Context& context);
 
@@ -24,6 +25,7 @@ inline void addCommands(CLI::App& app, Context& context) {
   addSimulateCommand(app, context);
   addBuildCommand(app, context);
   addInfoCommand(app, context);
+  addRegisterCommand(app, context);
   addRegisterCommand(app, context);
   addPlanesCommand(app, context);
   addLabelCommand(app, context);

@@ -36,12 +36,15 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   return m;
 }
 
+// Every `stride`-th source point gets a correspondence; the others are marked invalid.
 void associate(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& pose,
-               double gate, IcpMetric metric, std::vector<Correspondence>& correspondences) {
+               double gate, IcpMetric metric, long stride, std::vector<Correspondence>& correspondences) {
   const long count = static_cast<long>(source.size());
 #pragma omp parallel for schedule(dynamic, 1024)
   for (long i = 0; i < count; ++i) {
     Correspondence& c = correspondences[static_cast<std::size_t>(i)];
+    c.valid = false;
+    if (i % stride != 0) continue;
     c.source = pose * source[static_cast<std::size_t>(i)];
     const auto neighbour = target.nearest(c.source, gate);
     c.valid = neighbour && (metric == IcpMetric::PointToPoint || !neighbour->normal.isZero());
@@ -168,12 +171,16 @@ IcpResult alignPoints(const std::vector<Point>& source, const VoxelHashMap& targ
   double radius_sq = 0.0;
   for (const Point& point : source) radius_sq += point.squaredNorm();
   const double radius = std::max(1.0, std::sqrt(radius_sq / static_cast<double>(source.size())));
+  result.radius = radius;
 
   std::vector<Correspondence> correspondences(source.size());
   double gate = config.initial_max_distance;
   LinearSystem system;
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
-    associate(source, target, result.pose, gate, config.metric, correspondences);
+    // In the first iterations, while the gate is wide (the pose still far off, every
+    // search expensive), a quarter of the source points steers; all of them refine.
+    const long stride = iteration < 5 && gate > 2.0 * config.min_max_distance ? 4 : 1;
+    associate(source, target, result.pose, gate, config.metric, stride, correspondences);
     const double spread = residualSpread(correspondences, config.metric, result.inliers, result.rms_residual);
     // The kernel scale is a third of the gate: while the pose is still uncertain every
     // correspondence in the gate pulls, even when most residuals are already small.
@@ -192,7 +199,7 @@ IcpResult alignPoints(const std::vector<Point>& source, const VoxelHashMap& targ
     const double motion = step_translation + step_rotation * radius;
     const double next_gate =
         std::max(config.min_max_distance, std::min(gate, 3.0 * spread + 2.0 * motion));
-    const bool settled = next_gate == gate;
+    const bool settled = gate - next_gate < 0.01 * gate && stride == 1;
     gate = next_gate;
     if (settled && step_translation < config.convergence_translation &&
         step_rotation < config.convergence_rotation) {

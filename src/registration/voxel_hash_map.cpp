@@ -13,6 +13,25 @@ namespace {
 constexpr long kKeyCentre = 32768;  // octomap's tree_max_val at depth 16
 constexpr long kKeyMax = 65535;
 
+// The PCA normal of a neighbourhood, or zero when it is not planar.
+Normal planeNormal(const std::vector<Point>& neighbourhood, const NormalConfig& config) {
+  if (neighbourhood.size() < config.min_neighbours) return Normal::Zero();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Point& p : neighbourhood) mean += p;
+  mean /= static_cast<double>(neighbourhood.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const Point& p : neighbourhood) covariance.noalias() += (p - mean) * (p - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  const Eigen::Vector3d eigenvalues = solver.eigenvalues();  // ascending
+  const double total = eigenvalues.sum();
+  // Planar: thin across (low curvature) and spread in two directions (not a line or a
+  // strip of one scan line, whose normal can turn about the line).
+  if (total > 0.0 && eigenvalues[0] / total <= config.max_curvature && eigenvalues[1] > 0.05 * eigenvalues[2]) {
+    return solver.eigenvectors().col(0).normalized();
+  }
+  return Normal::Zero();
+}
+
 }  // namespace
 
 VoxelHashMap::VoxelHashMap(double voxel_size, std::size_t max_points_per_voxel)
@@ -28,7 +47,7 @@ void VoxelHashMap::addPoints(const std::vector<Point>& points) {
     Voxel& voxel = voxels_[key];
     if (voxel.points.size() >= max_points_per_voxel_) continue;
     voxel.points.push_back(point);
-    voxel.normals.push_back(Normal::Zero());
+    voxel.dirty = true;
     ++size_;
   }
 }
@@ -88,12 +107,12 @@ std::optional<Neighbour> VoxelHashMap::nearest(const Point& query, double max_di
   const Point* best_point = nullptr;
   const Normal* best_normal = nullptr;
   visitVoxels(query, max_distance, [&](const Voxel& voxel) {
-    for (std::size_t i = 0; i < voxel.points.size(); ++i) {
-      const double distance_sq = (voxel.points[i] - query).squaredNorm();
+    for (const Point& point : voxel.points) {
+      const double distance_sq = (point - query).squaredNorm();
       if (distance_sq <= best_sq) {
         best_sq = distance_sq;
-        best_point = &voxel.points[i];
-        best_normal = &voxel.normals[i];
+        best_point = &point;
+        best_normal = &voxel.normal;
       }
     }
     return std::sqrt(best_sq);
@@ -116,38 +135,22 @@ std::vector<Point> VoxelHashMap::within(const Point& query, double radius) const
 }
 
 void VoxelHashMap::estimateNormals(const NormalConfig& config) {
-  // The points still without an estimate, in a flat list so the loop can be parallel;
-  // each writes only its own normal, so the result does not depend on the thread count.
-  std::vector<std::pair<Voxel*, std::size_t>> pending;
+  // The voxels that gained points, in a flat list so the loop can be parallel; each
+  // writes only its own normal, so the result does not depend on the thread count.
+  std::vector<Voxel*> dirty;
   for (auto& [key, voxel] : voxels_) {
-    for (std::size_t i = voxel.estimated; i < voxel.points.size(); ++i) pending.emplace_back(&voxel, i);
-    voxel.estimated = voxel.points.size();
+    if (voxel.dirty) dirty.push_back(&voxel);
   }
-  const long count = static_cast<long>(pending.size());
-#pragma omp parallel for schedule(dynamic, 256)
+  const long count = static_cast<long>(dirty.size());
+#pragma omp parallel for schedule(dynamic, 64)
   for (long n = 0; n < count; ++n) {
-    auto [voxel, index] = pending[static_cast<std::size_t>(n)];
-    const Point& point = voxel->points[index];
-    const std::vector<Point> neighbourhood = within(point, config.radius);
-    Normal normal = Normal::Zero();
-    if (neighbourhood.size() >= config.min_neighbours) {
-      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      for (const Point& p : neighbourhood) mean += p;
-      mean /= static_cast<double>(neighbourhood.size());
-      Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-      for (const Point& p : neighbourhood) covariance += (p - mean) * (p - mean).transpose();
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
-      const Eigen::Vector3d eigenvalues = solver.eigenvalues();  // ascending
-      const double total = eigenvalues.sum();
-      // Planar: thin across (low curvature) and spread in two directions (not a line or a
-      // strip of one scan line, whose normal can turn about the line).
-      if (total > 0.0 && eigenvalues[0] / total <= config.max_curvature &&
-          eigenvalues[1] > 0.05 * eigenvalues[2]) {
-        normal = solver.eigenvectors().col(0).normalized();
-      }
-    }
-    voxel->normals[index] = normal;
+    Voxel& voxel = *dirty[static_cast<std::size_t>(n)];
+    Point centre = Point::Zero();
+    for (const Point& point : voxel.points) centre += point;
+    centre /= static_cast<double>(voxel.points.size());
+    voxel.normal = planeNormal(within(centre, config.radius), config);
   }
+  for (Voxel* voxel : dirty) voxel->dirty = false;
 }
 
 std::vector<Point> VoxelHashMap::points() const {

@@ -49,6 +49,7 @@ struct IcpResult {
   Matrix6d hessian = Matrix6d::Zero();
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
   double kernel_scale = 0.0;     // m, the final Geman–McClure scale
+  double radius = 1.0;           // m, RMS range of the source: scales rotations to metres
 };
 
 // Aligns `source` (in its own frame) to `target`, starting from `initial_guess`

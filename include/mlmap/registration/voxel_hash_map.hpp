@@ -24,7 +24,7 @@ struct Neighbour {
 };
 
 struct NormalConfig {
-  double radius = 0.25;            // m, PCA neighbourhood of a point
+  double radius = 0.2;             // m, PCA neighbourhood of a voxel's centroid
   std::size_t min_neighbours = 6;  // fewer leaves the normal zero
   double max_curvature = 0.05;     // λ_min / (λ0 + λ1 + λ2) above this: not planar, zero normal
 };
@@ -38,8 +38,8 @@ class VoxelHashMap {
 
   // Points outside the OcTree's key range (±32768 voxels) are skipped.
   void addPoints(const std::vector<Point>& points);
-  // Normals (PCA over the points within config.radius) of the points added since the
-  // last call; earlier points keep theirs.
+  // One normal per voxel: PCA over the points within config.radius of the voxel's
+  // centroid, for the voxels that gained points since the last call.
   void estimateNormals(const NormalConfig& config = {});
 
   // The nearest point within `max_distance` of `query`, if any.
@@ -56,8 +56,8 @@ class VoxelHashMap {
  private:
   struct Voxel {
     std::vector<Point> points;
-    std::vector<Normal> normals;  // one per point
-    std::size_t estimated = 0;    // points [0, estimated) have had their normal estimated
+    Normal normal = Normal::Zero();  // shared by the voxel's points
+    bool dirty = false;              // gained points since the last estimateNormals()
   };
   template <typename Visit>
   void visitVoxels(const Point& query, double radius, Visit&& visit) const;

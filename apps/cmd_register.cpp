@@ -1,0 +1,145 @@
+// mlmap register: scans + odometry poses -> corrected poses (TUM), by scan-to-map ICP and
+// a pose graph over overlapping pairs.
+#include <chrono>
+#include <cstdio>
+
+#include "commands.hpp"
+#include "mlmap/error.hpp"
+#include "mlmap/io/scan_file.hpp"
+#include "mlmap/io/tum_poses.hpp"
+#include "mlmap/registration/sequence_registration.hpp"
+#include "mlmap/registration/trajectory_error.hpp"
+#include "progress.hpp"
+
+namespace mlmap::cli {
+namespace {
+
+struct RegisterOptions {
+  std::string output;
+  std::string poses;
+  std::string reference;
+  std::vector<std::string> scans;
+  std::string metric = "point-to-plane";
+  bool no_refine = false;
+  registration::SequenceConfig config;
+};
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void printError(const char* label, const std::vector<Pose>& poses, const std::vector<Pose>& reference) {
+  const registration::TrajectoryError error = registration::trajectoryError(poses, reference);
+  std::printf("%s ATE: translation RMS %.2f cm (max %.2f cm), rotation RMS %.3f deg (max %.3f deg)\n", label,
+              100.0 * error.rms_translation, 100.0 * error.max_translation, error.rms_rotation_deg,
+              error.max_rotation_deg);
+}
+
+int runRegister(RegisterOptions options, bool quiet) {
+  options.config.icp.metric = options.metric == "point-to-point" ? registration::IcpMetric::PointToPoint
+                                                                   : registration::IcpMetric::PointToPlane;
+  std::vector<io::StampedPose> odometry;
+  if (!options.poses.empty()) odometry = io::readTumPoses(options.poses);
+
+  registration::SequenceRegistration sequence(options.config);
+  std::vector<io::StampedPose> stamped;
+  std::vector<Pose> odometry_poses;
+  double register_seconds = 0.0;
+  std::size_t point_count = 0;
+  Progress progress("register", options.scans.size(), !quiet);
+  for (std::size_t file = 0; file < options.scans.size(); ++file) {
+    for (const Scan& scan : io::readScans(options.scans[file])) {
+      const std::size_t index = stamped.size();
+      if (!odometry.empty() && index >= odometry.size()) {
+        throw Error(options.poses + ": " + std::to_string(odometry.size()) +
+                    " poses, but there are more scans (" + options.scans[file] + " is scan " +
+                    std::to_string(index + 1) + ")");
+      }
+      const io::StampedPose guess = odometry.empty() ? io::StampedPose{static_cast<double>(index), scan.pose}
+                                                     : odometry[index];
+      const auto start = std::chrono::steady_clock::now();
+      const registration::IcpResult result = sequence.addScan(scan.points, guess.pose);
+      register_seconds += secondsSince(start);
+      point_count += scan.size();
+      stamped.push_back(guess);
+      odometry_poses.push_back(guess.pose);
+      if (!quiet || result.unreliable) {
+        std::fprintf(stderr, "scan %zu: %zu points, %zu/%zu inliers, RMS %.2f cm, %d iterations%s%s\n", index,
+                     scan.size(), result.inliers, result.source_points, 100.0 * result.rms_residual,
+                     result.iterations, result.degenerate ? ", degenerate" : "",
+                     result.unreliable ? ", UNRELIABLE" : "");
+      }
+    }
+    progress.update(file + 1, std::to_string(point_count) + " points");
+  }
+  if (!odometry.empty() && stamped.size() != odometry.size()) {
+    throw Error(options.poses + ": " + std::to_string(odometry.size()) + " poses for " +
+                std::to_string(stamped.size()) + " scans");
+  }
+  progress.finish(std::to_string(point_count) + " points");
+  const std::vector<Pose> sequential = sequence.poses();
+
+  double refine_seconds = 0.0;
+  if (!options.no_refine) {
+    const auto start = std::chrono::steady_clock::now();
+    const registration::RefinementResult refinement = sequence.refine();
+    refine_seconds = secondsSince(start);
+    std::printf("refinement: %zu pair edges (%zu pairs rejected), graph cost %.4g -> %.4g in %.2f s\n",
+                refinement.pair_edges, refinement.rejected_pairs, refinement.graph.initial_cost,
+                refinement.graph.final_cost, refine_seconds);
+  }
+  for (std::size_t i = 0; i < stamped.size(); ++i) stamped[i].pose = sequence.poses()[i];
+  io::writeTumPoses(options.output, stamped);
+  std::printf("%s: %zu scans, %zu points; scan-to-map %.3f s per scan, refinement %.2f s\n",
+              options.output.c_str(), stamped.size(), point_count,
+              stamped.empty() ? 0.0 : register_seconds / static_cast<double>(stamped.size()), refine_seconds);
+  if (!options.reference.empty()) {
+    std::vector<Pose> reference;
+    for (const io::StampedPose& pose : io::readTumPoses(options.reference)) reference.push_back(pose.pose);
+    printError("odometry  ", odometry_poses, reference);
+    printError("scan-to-map", sequential, reference);
+    if (!options.no_refine) printError("refined   ", sequence.poses(), reference);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void addRegisterCommand(CLI::App& app, Context& context) {
+  auto options = std::make_shared<RegisterOptions>();
+  auto* command = app.add_subcommand(
+      "register", "Correct odometry poses by ICP: scan-to-map, then a pose graph over overlapping pairs");
+  command->add_option("-o,--output", options->output, "Corrected poses to write (TUM)")->required();
+  command->add_option("--poses", options->poses,
+                      "Odometry poses (TUM), one per scan in order; without it each scan's own pose");
+  command->add_option("--reference", options->reference,
+                      "Reference poses (TUM, same world frame) to print the absolute trajectory error");
+  command->add_option("--metric", options->metric, "ICP error metric")
+      ->check(CLI::IsMember({"point-to-plane", "point-to-point"}))
+      ->default_val("point-to-plane");
+  command->add_option("--voxel-size", options->config.source_voxel_size,
+                      "Down-sampling of the scan being registered, m")
+      ->default_val(0.1)
+      ->check(CLI::PositiveNumber);
+  command->add_option("--map-voxel-size", options->config.map_voxel_size,
+                      "OcTree resolution of the map's nearest-neighbour grid, m")
+      ->default_val(0.1)
+      ->check(CLI::PositiveNumber);
+  command->add_option("--max-distance", options->config.icp.initial_max_distance,
+                      "Initial correspondence distance, m: a bound on the odometry error")
+      ->default_val(0.5)
+      ->check(CLI::PositiveNumber);
+  command->add_option("--max-range", options->config.max_range, "Drop points farther than this, m")
+      ->default_val(30.0)
+      ->check(CLI::PositiveNumber);
+  command->add_flag("--no-refine", options->no_refine, "Scan-to-map only, no pose graph");
+  command->add_option("scans", options->scans,
+                      "Scan files in order: .xyz .txt .pts .ply .pcd .3d (3DTK) .graph (OctoMap)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->callback([options, &context] {
+    context.run = [options, &context] { return runRegister(*options, context.quiet); };
+  });
+}
+
+}  // namespace mlmap::cli

@@ -1,0 +1,139 @@
+#include "mlmap/registration/sequence_registration.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "mlmap/registration/preprocessing.hpp"
+
+namespace mlmap::registration {
+namespace {
+
+std::vector<Point> transformed(const std::vector<Point>& points, const Pose& pose) {
+  std::vector<Point> result;
+  result.reserve(points.size());
+  for (const Point& point : points) result.push_back(pose * point);
+  return result;
+}
+
+// Information of an ICP result: its normal equations over the residual variance, without
+// the directions ICP flags as degenerate (their eigenvalues are noise, not measurement),
+// so odometry alone holds the graph there.
+Matrix6d icpInformation(const IcpResult& result, double min_sigma, double min_eigenvalue_ratio,
+                        double radius) {
+  const double sigma = std::max(result.rms_residual, min_sigma);
+  Vector6d scaling;
+  scaling << Eigen::Vector3d::Constant(1.0 / radius), Eigen::Vector3d::Ones();
+  const Matrix6d scaled = scaling.asDiagonal() * result.hessian * scaling.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(scaled);
+  Matrix6d kept = Matrix6d::Zero();
+  for (int k = 0; k < 6; ++k) {
+    const double eigenvalue = solver.eigenvalues()[k];
+    if (eigenvalue < min_eigenvalue_ratio * solver.eigenvalues()[5]) continue;
+    kept += eigenvalue * solver.eigenvectors().col(k) * solver.eigenvectors().col(k).transpose();
+  }
+  const Vector6d unscaling = scaling.cwiseInverse();
+  return unscaling.asDiagonal() * kept * unscaling.asDiagonal() / (sigma * sigma);
+}
+
+}  // namespace
+
+SequenceRegistration::SequenceRegistration(const SequenceConfig& config)
+    : config_(config), map_(config.map_voxel_size, config.max_points_per_voxel) {}
+
+IcpResult SequenceRegistration::addScan(const std::vector<Point>& points, const Pose& odometry) {
+  const std::vector<Point> cropped = cropRange(points, config_.min_range, config_.max_range);
+  // The map and the local maps take a finer sample than the ICP source: their normals
+  // need neighbours.
+  const std::vector<Point> dense = voxelDownSample(cropped, config_.map_voxel_size / 2.0);
+  std::vector<Point> source = voxelDownSample(cropped, config_.source_voxel_size);
+
+  IcpResult result;
+  Pose pose = odometry;
+  if (poses_.empty()) {
+    result.pose = pose;
+    result.converged = true;
+    result.unreliable = false;
+    result.source_points = source.size();
+  } else {
+    const Pose guess = poses_.back() * (odometry_.back().inverse() * odometry);
+    result = alignPoints(source, map_, guess, config_.icp);
+    pose = result.pose;
+  }
+  map_.addPoints(transformed(dense, pose));
+  map_.estimateNormals(config_.normals);
+  dense_.push_back(std::move(dense));
+  sources_.push_back(std::move(source));
+  odometry_.push_back(odometry);
+  poses_.push_back(pose);
+  chain_.push_back(pose);
+  return result;
+}
+
+RefinementResult SequenceRegistration::refine() {
+  RefinementResult result;
+  if (poses_.size() < 2) return result;
+  IcpConfig pair_config = config_.icp;
+  pair_config.initial_max_distance = std::max(config_.icp.min_max_distance, 0.25);
+  // Each scan alone in its sensor frame: the targets of the pairwise ICP.
+  std::vector<VoxelHashMap> locals;
+  for (const std::vector<Point>& dense : dense_) {
+    locals.emplace_back(config_.map_voxel_size, config_.max_points_per_voxel);
+    locals.back().addPoints(dense);
+    locals.back().estimateNormals(config_.normals);
+  }
+  for (int round = 0; round < config_.refinement_rounds; ++round) {
+    std::vector<PoseGraphEdge> edges;
+    for (std::size_t i = 0; i + 1 < poses_.size(); ++i) {
+      PoseGraphEdge edge;
+      edge.from = i;
+      edge.to = i + 1;
+      edge.measurement = chain_[i].inverse() * chain_[i + 1];
+      edge.pivot = edge.measurement.translation();
+      const double rotation_sq = config_.chain_sigma_rotation * config_.chain_sigma_rotation;
+      const double translation_sq = config_.chain_sigma_translation * config_.chain_sigma_translation;
+      edge.information.diagonal() << Eigen::Vector3d::Constant(1.0 / rotation_sq),
+          Eigen::Vector3d::Constant(1.0 / translation_sq);
+      edges.push_back(edge);
+    }
+    // Candidate pairs, then pairwise ICP in parallel (each pair writes only its own slot).
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    for (std::size_t i = 0; i < poses_.size(); ++i) {
+      for (std::size_t j = i + 1; j < poses_.size(); ++j) {
+        if ((poses_[i].translation() - poses_[j].translation()).norm() <= config_.max_pair_distance) {
+          pairs.emplace_back(i, j);
+        }
+      }
+    }
+    std::vector<IcpResult> pair_results(pairs.size());
+#pragma omp parallel for schedule(dynamic, 1)
+    for (long p = 0; p < static_cast<long>(pairs.size()); ++p) {
+      const auto [i, j] = pairs[static_cast<std::size_t>(p)];
+      pair_results[static_cast<std::size_t>(p)] =
+          alignPoints(sources_[j], locals[i], poses_[i].inverse() * poses_[j], pair_config);
+    }
+    result.pair_edges = 0;
+    result.rejected_pairs = 0;
+    for (std::size_t p = 0; p < pairs.size(); ++p) {
+      const IcpResult& icp = pair_results[p];
+      const double overlap =
+          icp.source_points > 0 ? static_cast<double>(icp.inliers) / static_cast<double>(icp.source_points) : 0.0;
+      if (!icp.converged || icp.inliers < config_.icp.min_inliers || overlap < config_.min_overlap) {
+        ++result.rejected_pairs;
+        continue;
+      }
+      PoseGraphEdge edge;
+      edge.from = pairs[p].first;
+      edge.to = pairs[p].second;
+      edge.measurement = icp.pose;
+      edge.pivot = icp.pivot;
+      edge.information = icpInformation(icp, config_.icp.min_kernel_scale, config_.icp.min_eigenvalue_ratio,
+                                        icp.radius);
+      edges.push_back(edge);
+      ++result.pair_edges;
+    }
+    result.graph = optimizePoseGraph(poses_, edges);
+  }
+  return result;
+}
+
+}  // namespace mlmap::registration
