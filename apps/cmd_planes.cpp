@@ -63,6 +63,8 @@ void addPlanesCommand(CLI::App& app, Context& context) {
   command->add_option("--min-area", config.min_area, "s_m: minimal plane surface, m²")->capture_default_str();
   command->add_option("--min-patch-area", config.min_patch_area, "Smaller connected patches are dropped, m²")->capture_default_str();
   command->add_option("--max-candidates", config.max_candidates, "Max_cp: candidates in all")->capture_default_str();
+  command->add_option("--max-idle-candidates", config.max_idle_candidates,
+                      "Stop after this many candidates without an accepted plane")->capture_default_str();
   command->callback([arguments, &context] {
     context.run = [arguments, &context] { return runPlanes(*arguments, context.quiet); };
   });

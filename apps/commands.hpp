@@ -20,6 +20,9 @@ void addRegisterCommand(CLI::App& app, Context& context);
 void addRegisterCommand(CLI::App& app, Context& context);
 void addPlanesCommand(CLI::App& app, Context& context);
 void addLabelCommand(CLI::App& app, Context& context);
+void addScanCommand(CLI::App& app, Context& context);
+void addReplayCommand(CLI::App& app, Context& context);
+void addEmulateCommand(CLI::App& app, Context& context);
 
 inline void addCommands(CLI::App& app, Context& context) {
   addSimulateCommand(app, context);
@@ -29,6 +32,9 @@ inline void addCommands(CLI::App& app, Context& context) {
   addRegisterCommand(app, context);
   addPlanesCommand(app, context);
   addLabelCommand(app, context);
+  addScanCommand(app, context);
+  addReplayCommand(app, context);
+  addEmulateCommand(app, context);
 }
 
 }  // namespace mlmap::cli

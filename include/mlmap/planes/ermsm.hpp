@@ -29,7 +29,7 @@ struct ErmsmConfig {
   double min_patch_width_cells = 0.7;  // cells, and patches whose blocks spread less across (std-dev)
   double max_direction_spread_deg = 10.0;  // deg, mean angle of a plane's blocks to its normal (curved surfaces fail)
   int max_candidates = 4000;      // Max_cp: Algorithm 1 stops after this many candidates
-  int max_idle_candidates = 1000; // ... or after this many without an accepted plane
+  int max_idle_candidates = 300;  // ... or after this many without an accepted plane
   int batch_size = 16;            // candidates per iteration of Algorithm 1 (fixed, not per thread)
   int max_refits = 5;             // Algorithm 2's iterations at most
   double refit_gain = 1.0;        // surface units: Algorithm 2 stops when a refit gains less
