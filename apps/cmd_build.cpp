@@ -8,6 +8,8 @@
 #include "mlmap/io/scan_file.hpp"
 #include "mlmap/io/tum_poses.hpp"
 #include "mlmap/map/map.hpp"
+#include "mlmap/registration/floor_calibration.hpp"
+#include "mlmap/registration/sequence_registration.hpp"
 #include "progress.hpp"
 
 namespace mlmap::cli {
@@ -20,11 +22,45 @@ struct BuildOptions {
   MapConfig map;
   bool no_octree = false;
   double range_sigma = 0.0;
+  bool register_scans = false;  // correct the poses by ICP before building
+  std::string mount;            // mount.json: roll/pitch applied to sensor-frame points
 };
+
+// --register: one pass over the scans for scan-to-map ICP and the pose graph, from the
+// given poses (odometry) or each scan's own; returns one corrected pose per scan.
+std::vector<io::StampedPose> registeredPoses(const BuildOptions& options, std::vector<io::StampedPose> poses,
+                                             const registration::MountCorrection& mount, bool quiet) {
+  registration::SequenceRegistration sequence;
+  std::vector<io::StampedPose> corrected;
+  Progress progress("register", options.scans.size(), !quiet);
+  for (std::size_t file = 0; file < options.scans.size(); ++file) {
+    for (Scan& scan : io::readScans(options.scans[file])) {
+      registration::applyMountCorrection(scan, mount);
+      const std::size_t index = corrected.size();
+      if (!poses.empty() && index >= poses.size()) {
+        throw Error(options.poses + ": " + std::to_string(poses.size()) + " poses, but there are more scans");
+      }
+      corrected.push_back(poses.empty() ? io::StampedPose{static_cast<double>(index), scan.pose} : poses[index]);
+      const registration::IcpResult result = sequence.addScan(scan.points, corrected.back().pose);
+      if (result.unreliable && !quiet) {
+        std::fprintf(stderr, "register: scan %zu (%s) is unreliable: %zu inliers%s\n", index,
+                     options.scans[file].c_str(), result.inliers, result.degenerate ? ", degenerate geometry" : "");
+      }
+    }
+    progress.update(file + 1);
+  }
+  sequence.refine();
+  progress.finish();
+  for (std::size_t i = 0; i < corrected.size(); ++i) corrected[i].pose = sequence.poses()[i];
+  return corrected;
+}
 
 int runBuild(const BuildOptions& options, bool quiet) {
   std::vector<io::StampedPose> poses;
   if (!options.poses.empty()) poses = io::readTumPoses(options.poses);
+  registration::MountCorrection mount;
+  if (!options.mount.empty()) mount = registration::readMountCorrection(options.mount);
+  if (options.register_scans) poses = registeredPoses(options, poses, mount, quiet);
 
   // Scans are read one file at a time so memory holds the map, not every scan.
   MapConfig config = options.map;
@@ -44,6 +80,7 @@ int runBuild(const BuildOptions& options, bool quiet) {
         }
         scan.pose = poses[scan_count].pose;
       }
+      if (!options.mount.empty()) registration::applyMountCorrection(scan, mount);
       if (scan.variances.empty() && options.range_sigma > 0.0) {
         scan.variances.assign(scan.size(), options.range_sigma * options.range_sigma);
       }
@@ -93,6 +130,12 @@ void addBuildCommand(CLI::App& app, Context& context) {
                       "Range noise of scans that carry no per-point variance, m "
                       "(default: the UTM-30LX's 0.03)")
       ->check(CLI::PositiveNumber);
+  command->add_flag("--register", options->register_scans,
+                    "Correct the poses (--poses as odometry, else each scan's own) by scan-to-map ICP "
+                    "and a pose graph first, as `mlmap register` does");
+  command->add_option("--mount", options->mount,
+                      "Mount correction (mount.json from `mlmap calibrate`) applied to every scan")
+      ->check(CLI::ExistingFile);
   command->add_option("scans", options->scans,
                       "Scan files: .xyz .txt .pts .ply .pcd .3d (3DTK) .graph (OctoMap)")
       ->required()

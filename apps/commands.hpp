@@ -17,7 +17,7 @@ void addBuildCommand(CLI::App& app, Context& context);
 void addInfoCommand(CLI::App& app, Context& context);
 void addSimulateCommand(CLI::App& app, Context& context);
 void addRegisterCommand(CLI::App& app, Context& context);
-void addRegisterCommand(CLI::App& app, Context& context);
+void addCalibrateCommand(CLI::App& app, Context& context);
 void addPlanesCommand(CLI::App& app, Context& context);
 void addLabelCommand(CLI::App& app, Context& context);
 void addScanCommand(CLI::App& app, Context& context);
@@ -29,7 +29,7 @@ inline void addCommands(CLI::App& app, Context& context) {
   addBuildCommand(app, context);
   addInfoCommand(app, context);
   addRegisterCommand(app, context);
-  addRegisterCommand(app, context);
+  addCalibrateCommand(app, context);
   addPlanesCommand(app, context);
   addLabelCommand(app, context);
   addScanCommand(app, context);
