@@ -13,14 +13,26 @@ namespace {
 constexpr long kKeyCentre = 32768;  // octomap's tree_max_val at depth 16
 constexpr long kKeyMax = 65535;
 
+// Running sums of a neighbourhood for its PCA.
+struct Moments {
+  std::size_t count = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();  // Σ (p − reference)(p − reference)ᵀ
+  Point reference = Point::Zero();                  // subtracted first, for precision far from 0
+  void add(const Point& point) {
+    const Eigen::Vector3d d = point - reference;
+    ++count;
+    sum += d;
+    outer.noalias() += d * d.transpose();
+  }
+};
+
 // The PCA normal of a neighbourhood, or zero when it is not planar.
-Normal planeNormal(const std::vector<Point>& neighbourhood, const NormalConfig& config) {
-  if (neighbourhood.size() < config.min_neighbours) return Normal::Zero();
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const Point& p : neighbourhood) mean += p;
-  mean /= static_cast<double>(neighbourhood.size());
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const Point& p : neighbourhood) covariance.noalias() += (p - mean) * (p - mean).transpose();
+Normal planeNormal(const Moments& moments, const NormalConfig& config) {
+  if (moments.count < config.min_neighbours) return Normal::Zero();
+  const double n = static_cast<double>(moments.count);
+  const Eigen::Vector3d mean = moments.sum / n;
+  const Eigen::Matrix3d covariance = moments.outer - n * mean * mean.transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
   const Eigen::Vector3d eigenvalues = solver.eigenvalues();  // ascending
   const double total = eigenvalues.sum();
@@ -148,7 +160,16 @@ void VoxelHashMap::estimateNormals(const NormalConfig& config) {
     Point centre = Point::Zero();
     for (const Point& point : voxel.points) centre += point;
     centre /= static_cast<double>(voxel.points.size());
-    voxel.normal = planeNormal(within(centre, config.radius), config);
+    Moments moments;
+    moments.reference = centre;
+    const double radius_sq = config.radius * config.radius;
+    visitVoxels(centre, config.radius, [&](const Voxel& neighbour) {
+      for (const Point& point : neighbour.points) {
+        if ((point - centre).squaredNorm() <= radius_sq) moments.add(point);
+      }
+      return config.radius;
+    });
+    voxel.normal = planeNormal(moments, config);
   }
   for (Voxel* voxel : dirty) voxel->dirty = false;
 }
