@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <tuple>
 
 #include "mlmap/driver/tilt_sync.hpp"
 #include "mlmap/error.hpp"
@@ -55,6 +56,19 @@ SweepResult runSweep(ScipClient& laser, PtuClient& ptu, const SweepOptions& opti
   const int pan_position = toPositions(options.pan_deg, pan_axis);
   const int start_position = toPositions(options.tilt_start_deg, tilt_axis);
   const int end_position = toPositions(options.tilt_end_deg, tilt_axis);
+  for (const auto& [degrees, position, info, name] :
+       {std::tuple{options.pan_deg, pan_position, &pan_axis, "pan"},
+        std::tuple{options.tilt_start_deg, start_position, &tilt_axis, "tilt start"},
+        std::tuple{options.tilt_end_deg, end_position, &tilt_axis, "tilt end"}}) {
+    if (position < info->min_position || position > info->max_position) {
+      char range[96];
+      std::snprintf(range, sizeof(range), "[%.2f, %.2f] deg",
+                    info->min_position * info->degreesPerPosition(),
+                    info->max_position * info->degreesPerPosition());
+      throw PtuError(PtuError::Kind::Refused, ptu.transport().name() + ": " + name + " " +
+                                                  std::to_string(degrees) + " deg is outside the unit's limits " + range);
+    }
+  }
   const int speed = std::max(1, toPositions(tiltSpeedDegS(options.rho_deg, revolution_hz), tilt_axis));  // eq. 3
   const int base = std::max(0, toPositions(options.base_speed_deg_s, tilt_axis));
   const int acceleration = std::max(1, toPositions(options.acceleration_deg_s2, tilt_axis));

@@ -209,10 +209,12 @@ void Emulator::laserLoop() {
   } single;
   int frames = 0;
   bool stalled = false;
+  bool behind = false;  // scans are due: do not wait for commands
   try {
     while (!stop_) {
       char chunk[512];
-      const std::size_t got = laser_->read(chunk, sizeof(chunk), std::chrono::milliseconds(1));
+      const std::size_t got =
+          laser_->read(chunk, sizeof(chunk), std::chrono::milliseconds(behind ? 0 : 1));
       if (stalled) continue;
       pending.append(chunk, got);
       if (pending.size() > 4096) pending.clear();  // garbage: drop it
@@ -257,8 +259,17 @@ void Emulator::laserLoop() {
       }
       // Scans whose revolution has ended.
       const double now = emulatedSeconds();
-      while (stream.active &&
-             static_cast<double>(stream.next_revolution + 1) * kRevolutionS <= now) {
+      // One scan per pass, so commands (QT) are never starved. A scene too heavy to cast
+      // in real time loses whole revolutions rather than bending the device clock.
+      const auto current = static_cast<std::uint64_t>(std::floor(now / kRevolutionS));
+      constexpr std::uint64_t kMaxLag = 200;  // revolutions (5 s) caught up on before skipping
+      if (stream.active && stream.next_revolution + kMaxLag <= current) {
+        skipped_revolutions_ += current - 1 - stream.next_revolution;
+        stream.next_revolution = current - 1;
+      }
+      behind = stream.active && stream.next_revolution + 2 <= current + 1;  // one is due
+      if (stream.active &&
+          static_cast<double>(stream.next_revolution + 1) * kRevolutionS <= now) {
         const std::string count = stream.endless ? "00" : (stream.remaining < 10 ? "0" : "") +
                                                               std::to_string(stream.remaining - 1);
         laser_->write(scanFrame(stream.echo + count, "99", stream.next_revolution, stream.start,
@@ -274,7 +285,6 @@ void Emulator::laserLoop() {
           laser_slave_hold_ = -1;
           return;
         }
-        if (stalled) break;
       }
       if (single.active && static_cast<double>(single.revolution + 1) * kRevolutionS <= now) {
         laser_->write(scanFrame(single.echo, "00", single.revolution, single.start, single.end,

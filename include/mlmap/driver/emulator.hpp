@@ -57,6 +57,8 @@ class Emulator {
   // s on the laser's (unwrapped) clock when the last tilt move began; nullopt before one.
   std::optional<double> lastTiltMoveStart() const;
   std::size_t framesSent() const { return frames_sent_.load(); }
+  // Revolutions not sent because ray casting could not keep up (lower the time scale).
+  std::size_t skippedRevolutions() const { return skipped_revolutions_.load(); }
   void stop();
 
   // Units of the emulated PTU (a PTU-46-17.5).
@@ -99,6 +101,7 @@ class Emulator {
   Pose base_pose_;
   std::atomic<bool> stop_{false};
   std::atomic<std::size_t> frames_sent_{0};
+  std::atomic<std::size_t> skipped_revolutions_{0};
   // laser state (laser thread only)
   bool laser_on_ = false, time_adjust_ = false, echo_ptu_ = true, terse_ = false, slaved_ = false;
   std::thread laser_thread_, ptu_thread_;
