@@ -70,11 +70,11 @@ int runScan(ScanArguments arguments, bool quiet) {
   const auto path = driver::saveScan(arguments.output, driver::nextScanIndex(arguments.output), result.scan);
   if (!arguments.log.empty()) log.save(arguments.log);
   std::printf("%s: %zu points from %zu laser scans in %.2f s (%.1f scans/s, %.0f points/s), "
-              "t0 uncertainty %.2f ms, %zu frames dropped\n",
+              "t0 uncertainty %.2f ms, %zu frames dropped, %zu revolutions missed\n",
               path.string().c_str(), result.scan.size(), result.scan_lines, seconds,
               static_cast<double>(result.scan_lines) / seconds,
               static_cast<double>(result.scan.size()) / seconds, result.sync_uncertainty_s * 1e3,
-              result.dropped_frames);
+              result.dropped_frames, result.missed_revolutions);
   return 0;
 }
 

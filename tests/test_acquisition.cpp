@@ -148,6 +148,7 @@ TEST_CASE("Driver end to end: exact ranges land on the scene's surfaces") {
   CHECK(result.scan.variances.size() == result.scan.size());
   CHECK(result.clock.rate == doctest::Approx(4.0).epsilon(0.01));
   CHECK(result.dropped_frames == 0);
+  CHECK(result.missed_revolutions <= run.skipped_revolutions);  // 0 unless the emulator lagged
   CHECK(run.sync_error_s <= result.sync_uncertainty_s);
   // A t_0 error moves a point by at most tilt speed × error × range (≤ 7 m here).
   const double tilt_speed = 2.0 * 40.0 * 3.14159265 / 180.0;
@@ -190,6 +191,8 @@ TEST_CASE("Driver faults: bad checksums and dropped lines are dropped, the scan 
   options.faults.dropped_line_frame = 20;
   const Run run = sweep(scene, options);
   CHECK(run.result.dropped_frames == 2);
+  CHECK(run.result.missed_revolutions >= 2);  // the two dropped frames
+  CHECK(run.result.missed_revolutions <= 2 + run.skipped_revolutions);
   CHECK(run.result.scan_lines >= 40);  // two of ~44 lines missing
   const Distances distances = surfaceDistances(scene, run.result.scan);
   CHECK(distances.rms < 0.002 + 2.0 * 40.0 * 3.14159265 / 180.0 * run.result.sync_uncertainty_s * 4.0);

@@ -133,6 +133,13 @@ SweepResult runSweep(ScipClient& laser, PtuClient& ptu, const SweepOptions& opti
   Scan& scan = result.scan;
   scan.pose = odometry_pose;
   const double min_range = parameters.min_range_mm * 1e-3, max_range = parameters.max_range_mm * 1e-3;
+  const double revolution_ms = 1000.0 / revolution_hz;
+  for (std::size_t k = 1; k < lines.size(); ++k) {
+    const double gap_ms = static_cast<double>(lines[k].timestamp_ms - lines[k - 1].timestamp_ms);
+    if (gap_ms > 1.5 * revolution_ms) {
+      result.missed_revolutions += static_cast<std::size_t>(std::lround(gap_ms / revolution_ms)) - 1;
+    }
+  }
   for (const ScipScan& line : lines) {
     const double scan_start = static_cast<double>(line.timestamp_ms) * 1e-3;
     bool used = false;
@@ -150,6 +157,11 @@ SweepResult runSweep(ScipClient& laser, PtuClient& ptu, const SweepOptions& opti
       scan.variances.push_back(rangeVariance(range));
     }
     if (used) ++result.scan_lines;
+  }
+  if (result.scan_lines == 0) {
+    throw Error(laser.transport().name() + ": no laser scan fell inside the " +
+                std::to_string(result.sweep_duration_s) + " s tilt sweep (" +
+                std::to_string(result.missed_revolutions) + " revolutions missing from the stream)");
   }
   return result;
 }

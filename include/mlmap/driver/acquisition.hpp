@@ -34,7 +34,8 @@ struct SweepOptions {
 struct SweepResult {
   Scan scan;                     // base-frame points, variance from range, pose = odometry
   std::size_t scan_lines = 0;    // laser scans inside the sweep
-  std::size_t dropped_frames = 0;
+  std::size_t dropped_frames = 0;      // frames that failed their checks
+  std::size_t missed_revolutions = 0;  // gaps in the laser's timestamps (frames never sent)
   ClockModel clock;              // laser clock vs host clock
   double tilt_start_device_s = 0.0;  // t_0 of eq. 2 on the laser clock
   double sync_uncertainty_s = 0.0;   // half the TP round trip + clock fit residual
