@@ -13,6 +13,7 @@
 #include "mlmap/planes/classify.hpp"
 #include "mlmap/planes/direction_vectors.hpp"
 #include "mlmap/planes/patches.hpp"
+#include "pca_sums.hpp"
 #include "plane_scorer.hpp"
 
 #ifdef _OPENMP
@@ -163,11 +164,10 @@ void Detector::refit(Candidate& candidate) const {
   candidate.score = scorer_.score(candidate.plane);
   for (int iteration = 0; iteration < config_.max_refits; ++iteration) {
     const PlaneScore& score = candidate.score;
-    if (score.weight < 3.0) return;
-    const Eigen::Vector3d mean = score.sum / score.weight;
-    const Eigen::Matrix3d covariance = score.outer / score.weight - mean * mean.transpose();
+    if (score.pca.weight < 3.0) return;
+    const Eigen::Vector3d mean = score.pca.mean();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-    solver.computeDirect(covariance);
+    solver.computeDirect(score.pca.covariance());
     Eigen::Vector3f normal = solver.eigenvectors().col(0).cast<float>();
     if (!(normal.squaredNorm() > 0.5F)) return;
     if (normal.dot(candidate.plane.normal) < 0.0F) normal = -normal;
@@ -207,35 +207,21 @@ Plane Detector::describePatch(const Patch& patch, const CandidatePlane& referenc
   const double cell_area = grid_.cellSize() * grid_.cellSize();
   // Each patch is refitted on its own blocks, so two tables at slightly different
   // heights keep their own offsets.
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-  double weight = 0.0;
+  PcaSums pca;
   const Eigen::Vector3d origin = reference.point.cast<double>();
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const std::uint32_t id : patch.blocks) {
     const PlaneBlock& block = grid_.blocks()[id];
-    const Eigen::Vector3d relative = block.point.cast<double>() - origin;
     centroid += block.point.cast<double>();
-    if (block.vertical) {
-      const double half = 0.5 * (block.top - block.bottom);
-      for (const double dz : {half, -half}) {
-        const Eigen::Vector3d p = relative + Eigen::Vector3d(0, 0, dz);
-        sum += 0.5 * block.surface * p;
-        outer += 0.5 * block.surface * p * p.transpose();
-        weight += 0.5 * block.surface;
-      }
-    } else {
-      sum += relative;
-      outer += relative * relative.transpose();
-      weight += 1.0;
-    }
+    pca.addBlock(block.point.cast<double>() - origin, block.vertical ? 0.5 * (block.top - block.bottom) : 0.0,
+                 block.surface);
   }
   Eigen::Vector3d normal = reference.normal.cast<double>();
   Eigen::Vector3d point = origin;
-  if (weight >= 3.0) {
-    const Eigen::Vector3d mean = sum / weight;
+  if (pca.weight >= 3.0) {
+    const Eigen::Vector3d mean = pca.mean();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-    solver.computeDirect(outer / weight - mean * mean.transpose());
+    solver.computeDirect(pca.covariance());
     const Eigen::Vector3d fitted = solver.eigenvectors().col(0);
     // Keep the patch's own fit only where it is well defined and close to the plane's.
     if (solver.eigenvalues()(1) > 1e-4 && std::abs(fitted.dot(normal)) > std::cos(radians(config_.kappa_deg))) {
@@ -296,27 +282,20 @@ std::vector<std::uint32_t> Detector::withEdges(std::vector<std::uint32_t> matchi
 // boundary (stray points in the next column) or a line of clutter. Its blocks must
 // spread across the plane in both directions.
 bool Detector::isThin(const Patch& patch, const CandidatePlane& plane) const {
-  Eigen::Vector3d u = Eigen::Vector3d::UnitZ().cross(plane.normal.cast<double>());
-  if (u.norm() < 0.3) u = plane.normal.cast<double>().cross(Eigen::Vector3d::UnitX());
-  u.normalize();
-  const Eigen::Vector3d v = plane.normal.cast<double>().cross(u).normalized();
-  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-  Eigen::Matrix2d outer = Eigen::Matrix2d::Zero();
-  double weight = 0.0;
+  PcaSums pca;
   for (const std::uint32_t id : patch.blocks) {
     const PlaneBlock& block = grid_.blocks()[id];
-    const Eigen::Vector3d relative = block.point.cast<double>() - plane.point.cast<double>();
-    const double half = block.vertical ? 0.5 * (block.top - block.bottom) : 0.0;
-    for (const double dz : {half, -half}) {
-      const Eigen::Vector3d p = relative + Eigen::Vector3d(0.0, 0.0, dz);
-      const Eigen::Vector2d q(p.dot(u), p.dot(v));
-      sum += q;
-      outer += q * q.transpose();
-      weight += 1.0;
-    }
+    pca.addBlock((block.point - plane.point).cast<double>(),
+                 block.vertical ? 0.5 * (block.top - block.bottom) : 0.0, 1.0);
   }
-  const Eigen::Vector2d mean = sum / weight;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(outer / weight - mean * mean.transpose());
+  // The spread across the plane: the covariance in the plane's own basis.
+  Eigen::Vector3d u_axis;
+  Eigen::Vector3d v_axis;
+  planeBasis(plane.normal.cast<double>(), u_axis, v_axis);
+  Eigen::Matrix<double, 3, 2> basis;
+  basis << u_axis, v_axis;
+  const Eigen::Matrix2d in_plane = basis.transpose() * pca.covariance() * basis;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(in_plane);
   const double minor = std::sqrt(std::max(0.0, solver.eigenvalues()(0)));
   return minor < config_.min_patch_width_cells * grid_.cellSize();
 }

@@ -41,14 +41,16 @@ class DisjointSets {
   std::vector<std::size_t> parent_;
 };
 
-// A basis (u, v) of the plane: u horizontal when the plane is not, so walls read
-// as (along the wall, up).
+}  // namespace
+
 void planeBasis(const Eigen::Vector3d& normal, Eigen::Vector3d& u, Eigen::Vector3d& v) {
   u = Eigen::Vector3d::UnitZ().cross(normal);
   if (u.norm() < 0.3) u = normal.cross(Eigen::Vector3d::UnitX()).cross(normal);
   u.normalize();
   v = normal.cross(u).normalized();
 }
+
+namespace {
 
 // The outer boundary of a set of grid cells: the sides of occupied cells facing
 // empty ones, chained into loops; the loop enclosing the most area is the outline.

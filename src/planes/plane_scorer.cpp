@@ -81,23 +81,7 @@ PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
     result.similar += surface;
     if (std::abs(plane.normal.dot(bin.points[k]) + offset) >= epsilon_) return;
     result.score += surface;
-    const Eigen::Vector3d relative = (bin.points[k] - plane.point).cast<double>();
-    if (bin.half_depths[k] > 0.0F) {
-      // A wall of full-height blocks is a line through their mid-points: its top and
-      // bottom make the plane's normal definite.
-      const double half_depth = bin.half_depths[k];
-      const double weight = 0.5 * surface;
-      for (const double dz : {half_depth, -half_depth}) {
-        const Eigen::Vector3d p = relative + Eigen::Vector3d(0.0, 0.0, dz);
-        result.weight += weight;
-        result.sum += weight * p;
-        result.outer += weight * p * p.transpose();
-      }
-    } else {
-      result.weight += 1.0;
-      result.sum += relative;
-      result.outer += relative * relative.transpose();
-    }
+    result.pca.addBlock((bin.points[k] - plane.point).cast<double>(), bin.half_depths[k], surface);
   });
   return result;
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "mlmap/planes/block_grid.hpp"
+#include "pca_sums.hpp"
 
 namespace mlmap {
 
@@ -19,11 +20,7 @@ struct CandidatePlane {
 struct PlaneScore {
   double score = 0.0;    // s_c: surface of the untaken blocks matching the plane
   double similar = 0.0;  // s_o: surface of the untaken blocks of similar direction
-  // Weighted sums of the matching blocks' PCA points, relative to the plane's point,
-  // for Algorithm 2's refit (a vertical block gives its top and its bottom).
-  double weight = 0.0;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  PcaSums pca;           // of the matching blocks, relative to the plane's point (Algorithm 2)
 };
 
 class PlaneScorer {

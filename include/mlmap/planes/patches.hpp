@@ -17,6 +17,10 @@ struct Patch {
   std::vector<Eigen::Vector3d> outline;    // m, outer boundary on the plane, counter-clockwise about the normal
 };
 
+// A basis (u, v) of the plane with u × v = normal: u horizontal when the plane is not,
+// so walls read as (along the wall, up).
+void planeBasis(const Eigen::Vector3d& normal, Eigen::Vector3d& u, Eigen::Vector3d& v);
+
 // Blocks are rasterised on a grid of cell_size in the plane (a vertical block over
 // its whole height); occupied grid cells within `gap_cells` (Chebyshev) of each other
 // are connected. Patches are returned largest first.
