@@ -23,7 +23,7 @@ struct BuildOptions {
   bool no_octree = false;
   double range_sigma = 0.0;
   bool register_scans = false;  // correct the poses by ICP before building
-  std::string mount;            // mount.json: roll/pitch applied to sensor-frame points
+  std::string mount;            // from `mlmap calibrate`: roll/pitch applied to sensor-frame points
 };
 
 // --register: one pass over the scans for scan-to-map ICP and the pose graph, from the
@@ -134,7 +134,7 @@ void addBuildCommand(CLI::App& app, Context& context) {
                     "Correct the poses (--poses as odometry, else each scan's own) by scan-to-map ICP "
                     "and a pose graph first, as `mlmap register` does");
   command->add_option("--mount", options->mount,
-                      "Mount correction (mount.json from `mlmap calibrate`) applied to every scan")
+                      "Tilt correction (the JSON `mlmap calibrate` writes) applied to every scan")
       ->check(CLI::ExistingFile);
   command->add_option("scans", options->scans,
                       "Scan files: .xyz .txt .pts .ply .pcd .3d (3DTK) .graph (OctoMap)")

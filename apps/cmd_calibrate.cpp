@@ -1,4 +1,4 @@
-// mlmap calibrate: a floor scan -> mount.json, the roll/pitch that level the scanner
+// mlmap calibrate: a floor scan -> the roll/pitch (JSON) that level the scanner
 // (section VI's self-calibration).
 #include <cstdio>
 
@@ -35,7 +35,7 @@ int runCalibrate(const CalibrateOptions& options) {
 void addCalibrateCommand(CLI::App& app, Context& context) {
   auto options = std::make_shared<CalibrateOptions>();
   auto* command = app.add_subcommand(
-      "calibrate", "Find the scanner's inclination from a floor scan; write the correction (mount.json)");
+      "calibrate", "Find the scanner's inclination from a floor scan; write the tilt correction (JSON)");
   command->add_option("-o,--output", options->output, "Mount correction to write (JSON)")->required();
   command->add_option("--max-tilt", options->config.max_tilt_deg, "Search the floor within this of level, deg")
       ->default_val(20.0)
