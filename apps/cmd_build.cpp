@@ -3,13 +3,12 @@
 #include <cstdio>
 
 #include "commands.hpp"
-#include "mlmap/error.hpp"
 #include "mlmap/io/map_file.hpp"
-#include "mlmap/io/scan_file.hpp"
 #include "mlmap/io/tum_poses.hpp"
 #include "mlmap/map/map.hpp"
 #include "mlmap/registration/floor_calibration.hpp"
 #include "mlmap/registration/sequence_registration.hpp"
+#include "posed_scans.hpp"
 #include "progress.hpp"
 
 namespace mlmap::cli {
@@ -33,22 +32,18 @@ std::vector<io::StampedPose> registeredPoses(const BuildOptions& options, std::v
   registration::SequenceRegistration sequence;
   std::vector<io::StampedPose> corrected;
   Progress progress("register", options.scans.size(), !quiet);
-  for (std::size_t file = 0; file < options.scans.size(); ++file) {
-    for (Scan& scan : io::readScans(options.scans[file])) {
-      registration::applyMountCorrection(scan, mount);
-      const std::size_t index = corrected.size();
-      if (!poses.empty() && index >= poses.size()) {
-        throw Error(options.poses + ": " + std::to_string(poses.size()) + " poses, but there are more scans");
-      }
-      corrected.push_back(poses.empty() ? io::StampedPose{static_cast<double>(index), scan.pose} : poses[index]);
-      const registration::IcpResult result = sequence.addScan(scan.points, corrected.back().pose);
-      if (result.unreliable && !quiet) {
-        std::fprintf(stderr, "register: scan %zu (%s) is unreliable: %zu inliers%s\n", index,
-                     options.scans[file].c_str(), result.inliers, result.degenerate ? ", degenerate geometry" : "");
-      }
-    }
-    progress.update(file + 1);
-  }
+  forEachPosedScan(
+      options.scans, poses, options.poses,
+      [&](Scan& scan, std::size_t index, std::size_t file) {
+        registration::applyMountCorrection(scan, mount);
+        corrected.push_back(poses.empty() ? io::StampedPose{static_cast<double>(index), scan.pose} : poses[index]);
+        const registration::IcpResult result = sequence.addScan(scan.points, scan.pose);
+        if (result.unreliable && !quiet) {
+          std::fprintf(stderr, "register: scan %zu (%s) is unreliable: %zu inliers%s\n", index,
+                       options.scans[file].c_str(), result.inliers, result.degenerate ? ", degenerate geometry" : "");
+        }
+      },
+      [&](std::size_t file) { progress.update(file + 1); });
   sequence.refine();
   progress.finish();
   for (std::size_t i = 0; i < corrected.size(); ++i) corrected[i].pose = sequence.poses()[i];
@@ -62,7 +57,6 @@ int runBuild(const BuildOptions& options, bool quiet) {
   if (!options.mount.empty()) mount = registration::readMountCorrection(options.mount);
   if (options.register_scans) poses = registeredPoses(options, poses, mount, quiet);
 
-  // Scans are read one file at a time so memory holds the map, not every scan.
   MapConfig config = options.map;
   config.with_octree = !options.no_octree;
   Map map(config);
@@ -70,30 +64,18 @@ int runBuild(const BuildOptions& options, bool quiet) {
   Progress progress("build", options.scans.size(), !quiet);
   std::size_t scan_count = 0;
   std::size_t point_count = 0;
-  for (std::size_t file = 0; file < options.scans.size(); ++file) {
-    for (Scan& scan : io::readScans(options.scans[file])) {
-      if (!poses.empty()) {
-        if (scan_count >= poses.size()) {
-          throw Error(options.poses + ": " + std::to_string(poses.size()) +
-                      " poses, but there are more scans (" + options.scans[file] + " is scan " +
-                      std::to_string(scan_count + 1) + ")");
+  forEachPosedScan(
+      options.scans, poses, options.poses,
+      [&](Scan& scan, std::size_t, std::size_t) {
+        if (!options.mount.empty()) registration::applyMountCorrection(scan, mount);
+        if (scan.variances.empty() && options.range_sigma > 0.0) {
+          scan.variances.assign(scan.size(), options.range_sigma * options.range_sigma);
         }
-        scan.pose = poses[scan_count].pose;
-      }
-      if (!options.mount.empty()) registration::applyMountCorrection(scan, mount);
-      if (scan.variances.empty() && options.range_sigma > 0.0) {
-        scan.variances.assign(scan.size(), options.range_sigma * options.range_sigma);
-      }
-      map.insertScan(scan);
-      ++scan_count;
-      point_count += scan.size();
-    }
-    progress.update(file + 1, std::to_string(point_count) + " points");
-  }
-  if (!poses.empty() && scan_count != poses.size()) {
-    throw Error(options.poses + ": " + std::to_string(poses.size()) + " poses for " +
-                std::to_string(scan_count) + " scans");
-  }
+        map.insertScan(scan);
+        ++scan_count;
+        point_count += scan.size();
+      },
+      [&](std::size_t file) { progress.update(file + 1, std::to_string(point_count) + " points"); });
   map.compact();
   progress.finish(std::to_string(point_count) + " points");
   io::writeMap(options.output, map);

@@ -3,12 +3,11 @@
 #include <cstdio>
 
 #include "commands.hpp"
-#include "mlmap/error.hpp"
 #include "mlmap/io/map_file.hpp"
-#include "mlmap/io/scan_file.hpp"
 #include "mlmap/io/tum_poses.hpp"
 #include "mlmap/io/xyz.hpp"
 #include "mlmap/planes/point_labels.hpp"
+#include "posed_scans.hpp"
 #include "progress.hpp"
 
 namespace mlmap::cli {
@@ -26,33 +25,20 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
   std::vector<io::StampedPose> poses;
   if (!arguments.poses.empty()) poses = io::readTumPoses(arguments.poses);
   Scan labelled;  // all points, world frame
-  std::size_t scan_count = 0;
   std::size_t with_plane = 0;
   Progress progress("label", arguments.scans.size(), !quiet);
-  for (std::size_t file = 0; file < arguments.scans.size(); ++file) {
-    for (Scan& scan : io::readScans(arguments.scans[file])) {
-      if (!poses.empty()) {
-        if (scan_count >= poses.size()) {
-          throw Error(arguments.poses + ": " + std::to_string(poses.size()) +
-                      " poses, but there are more scans");
+  forEachPosedScan(
+      arguments.scans, poses, arguments.poses,
+      [&](Scan& scan, std::size_t, std::size_t) {
+        const std::vector<std::int32_t> labels = labelPoints(map.blocks(), scan);
+        for (std::size_t k = 0; k < scan.size(); ++k) {
+          labelled.points.push_back(scan.worldPoint(k));
+          // Blocks without a plane and points no block collects are both "none" here.
+          labelled.labels.push_back(labels[k] > 0 ? labels[k] : -1);
+          with_plane += labels[k] > 0 ? 1 : 0;
         }
-        scan.pose = poses[scan_count].pose;
-      }
-      ++scan_count;
-      const std::vector<std::int32_t> labels = labelPoints(map.blocks(), scan);
-      for (std::size_t k = 0; k < scan.size(); ++k) {
-        labelled.points.push_back(scan.worldPoint(k));
-        // Blocks without a plane and points no block collects are both "none" here.
-        labelled.labels.push_back(labels[k] > 0 ? labels[k] : -1);
-        with_plane += labels[k] > 0 ? 1 : 0;
-      }
-    }
-    progress.update(file + 1);
-  }
-  if (!poses.empty() && scan_count != poses.size()) {
-    throw Error(arguments.poses + ": " + std::to_string(poses.size()) + " poses for " +
-                std::to_string(scan_count) + " scans");
-  }
+      },
+      [&](std::size_t file) { progress.update(file + 1); });
   progress.finish();
   io::writeXyz(arguments.output, labelled);
   std::printf("%s: %zu points, %zu on a plane (%.1f %%)\n", arguments.output.c_str(), labelled.size(),

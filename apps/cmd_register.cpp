@@ -5,10 +5,10 @@
 
 #include "commands.hpp"
 #include "mlmap/error.hpp"
-#include "mlmap/io/scan_file.hpp"
 #include "mlmap/io/tum_poses.hpp"
 #include "mlmap/registration/sequence_registration.hpp"
 #include "mlmap/registration/trajectory_error.hpp"
+#include "posed_scans.hpp"
 #include "progress.hpp"
 
 namespace mlmap::cli {
@@ -47,35 +47,25 @@ int runRegister(RegisterOptions options, bool quiet) {
   double register_seconds = 0.0;
   std::size_t point_count = 0;
   Progress progress("register", options.scans.size(), !quiet);
-  for (std::size_t file = 0; file < options.scans.size(); ++file) {
-    for (const Scan& scan : io::readScans(options.scans[file])) {
-      const std::size_t index = stamped.size();
-      if (!odometry.empty() && index >= odometry.size()) {
-        throw Error(options.poses + ": " + std::to_string(odometry.size()) +
-                    " poses, but there are more scans (" + options.scans[file] + " is scan " +
-                    std::to_string(index + 1) + ")");
-      }
-      const io::StampedPose guess = odometry.empty() ? io::StampedPose{static_cast<double>(index), scan.pose}
-                                                     : odometry[index];
-      const auto start = std::chrono::steady_clock::now();
-      const registration::IcpResult result = sequence.addScan(scan.points, guess.pose);
-      register_seconds += secondsSince(start);
-      point_count += scan.size();
-      stamped.push_back(guess);
-      odometry_poses.push_back(guess.pose);
-      if (!quiet || result.unreliable) {
-        std::fprintf(stderr, "scan %zu: %zu points, %zu/%zu inliers, RMS %.2f cm, %d iterations%s%s\n", index,
-                     scan.size(), result.inliers, result.source_points, 100.0 * result.rms_residual,
-                     result.iterations, result.degenerate ? ", degenerate" : "",
-                     result.unreliable ? ", UNRELIABLE" : "");
-      }
-    }
-    progress.update(file + 1, std::to_string(point_count) + " points");
-  }
-  if (!odometry.empty() && stamped.size() != odometry.size()) {
-    throw Error(options.poses + ": " + std::to_string(odometry.size()) + " poses for " +
-                std::to_string(stamped.size()) + " scans");
-  }
+  forEachPosedScan(
+      options.scans, odometry, options.poses,
+      [&](Scan& scan, std::size_t index, std::size_t) {
+        const io::StampedPose guess = odometry.empty() ? io::StampedPose{static_cast<double>(index), scan.pose}
+                                                       : odometry[index];
+        const auto start = std::chrono::steady_clock::now();
+        const registration::IcpResult result = sequence.addScan(scan.points, guess.pose);
+        register_seconds += secondsSince(start);
+        point_count += scan.size();
+        stamped.push_back(guess);
+        odometry_poses.push_back(guess.pose);
+        if (!quiet || result.unreliable) {
+          std::fprintf(stderr, "scan %zu: %zu points, %zu/%zu inliers, RMS %.2f cm, %d iterations%s%s\n", index,
+                       scan.size(), result.inliers, result.source_points, 100.0 * result.rms_residual,
+                       result.iterations, result.degenerate ? ", degenerate" : "",
+                       result.unreliable ? ", UNRELIABLE" : "");
+        }
+      },
+      [&](std::size_t file) { progress.update(file + 1, std::to_string(point_count) + " points"); });
   progress.finish(std::to_string(point_count) + " points");
   const std::vector<Pose> sequential = sequence.poses();
 
