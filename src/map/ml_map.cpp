@@ -75,15 +75,21 @@ MLMap::MLMap(double cell_size) : cell_size_(cell_size), inverse_cell_size_(1.0 /
   slots_.assign(1024, kEmptySlot);
 }
 
-CellIndex MLMap::cellOf(double x, double y) const {
+std::optional<CellIndex> MLMap::findCellOf(double x, double y) const {
   const double column = std::floor(x * inverse_cell_size_);
   const double row = std::floor(y * inverse_cell_size_);
   constexpr double kLimit = 1 << 30;
-  if (!(std::abs(column) < kLimit && std::abs(row) < kLimit)) {
+  if (!(std::abs(column) < kLimit && std::abs(row) < kLimit)) return std::nullopt;
+  return CellIndex{static_cast<std::int32_t>(row), static_cast<std::int32_t>(column)};
+}
+
+CellIndex MLMap::cellOf(double x, double y) const {
+  const auto cell = findCellOf(x, y);
+  if (!cell) {
     throw Error("point (" + std::to_string(x) + ", " + std::to_string(y) +
                 ") is outside the map's range or not finite");
   }
-  return {static_cast<std::int32_t>(row), static_cast<std::int32_t>(column)};
+  return *cell;
 }
 
 Eigen::Vector2d MLMap::cellCenter(CellIndex cell) const {
@@ -181,14 +187,10 @@ void MLMap::insertScan(const Scan& scan) {
     const auto index = static_cast<std::size_t>(k);
     const Point world = scan.worldPoint(index);
     const double variance = scan.variance(index);
-    const double column = std::floor(world.x() * inverse_cell_size_);
-    const double row = std::floor(world.y() * inverse_cell_size_);
-    constexpr double kLimit = 1 << 30;
-    const bool valid = std::abs(column) < kLimit && std::abs(row) < kLimit &&
-                       std::isfinite(world.z()) && variance > 0.0 && std::isfinite(variance);
+    const auto cell = findCellOf(world.x(), world.y());
+    const bool valid = cell && std::isfinite(world.z()) && variance > 0.0 && std::isfinite(variance);
     all_valid = all_valid && valid;
-    cells[index] = valid ? CellIndex{static_cast<std::int32_t>(row), static_cast<std::int32_t>(column)}
-                         : CellIndex{};
+    cells[index] = valid ? *cell : CellIndex{};
     heights[index] = static_cast<float>(world.z());
     variances[index] = static_cast<float>(variance);
   }

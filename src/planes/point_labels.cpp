@@ -13,11 +13,11 @@ std::vector<std::int32_t> labelPoints(const MLMap& map, const Scan& scan) {
   for (std::int64_t k = 0; k < count; ++k) {
     const auto index = static_cast<std::size_t>(k);
     const Point p = scan.worldPoint(index);
-    if (!p.allFinite()) continue;
-    // Out-of-range coordinates have no cell; cellOf would throw inside the parallel loop.
-    if (std::abs(p.x() / reach) > (1 << 30) || std::abs(p.y() / reach) > (1 << 30)) continue;
+    // Points without a cell get no label (cellOf would throw inside the parallel loop).
+    const auto cell = map.findCellOf(p.x(), p.y());
+    if (!cell || !std::isfinite(p.z())) continue;
     double best = std::numeric_limits<double>::infinity();
-    for (const Block& block : map.blocks(map.cellOf(p.x(), p.y()))) {
+    for (const Block& block : map.blocks(*cell)) {
       const double distance = p.z() > block.height ? p.z() - block.height
                               : p.z() < block.bottom() ? block.bottom() - p.z()
                                                        : 0.0;

@@ -28,7 +28,8 @@ class MLMap {
   explicit MLMap(double cell_size);
 
   double cellSize() const { return cell_size_; }
-  CellIndex cellOf(double x, double y) const;
+  CellIndex cellOf(double x, double y) const;  // throws for coordinates beyond ±2^30 cells or NaN
+  std::optional<CellIndex> findCellOf(double x, double y) const;  // the same, without throwing
   Eigen::Vector2d cellCenter(CellIndex cell) const;  // (x, y) of the cell's centre
 
   // Adds one measurement p (world frame) with variance σ_m by the rules of Fig. 3.
