@@ -19,8 +19,10 @@ struct PlanesArguments {
 int runPlanes(const PlanesArguments& arguments, bool quiet) {
   Map map = io::readMap(arguments.map);
   if (!quiet) std::fprintf(stderr, "planes: %zu blocks ...\n", map.blocks().blockCount());
-  const PlaneDetection detection = detectPlanes(map.blocks(), arguments.config);
+  map.setPlanes(detectPlanes(map.blocks(), arguments.config));
+  const PlaneDetection& detection = *map.planes();
   if (!arguments.json.empty()) io::writePlanesJson(arguments.json, map, detection, arguments.map);
+  // The map carries its planes, so `mlmap export` needs no second detection run.
   if (!arguments.output.empty()) io::writeMap(arguments.output, map);
   const ErmsmStats& stats = detection.stats;
   std::printf("%s: %zu blocks, %zu planes (%zu patches) from %zu candidates in %.3f s "

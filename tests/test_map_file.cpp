@@ -110,9 +110,9 @@ TEST_CASE("MapFile: damaged, truncated, foreign and future files are refused by 
   }
   SUBCASE("another version") {
     std::string future = good;
-    future[8] = 2;
+    future[8] = 3;
     test::writeText(dir / "future.mlmap", future);
-    CHECK_THROWS_WITH_AS(io::readMap(dir / "future.mlmap"), doctest::Contains("version 2"), Error);
+    CHECK_THROWS_WITH_AS(io::readMap(dir / "future.mlmap"), doctest::Contains("version 3"), Error);
   }
   SUBCASE("a hostile cell count with a valid checksum") {
     std::string hostile = good.substr(0, good.size() - 4);
@@ -132,4 +132,56 @@ TEST_CASE("MapFile: a failed write leaves the old file untouched") {
   const std::string before = test::readText(dir / "map.mlmap");
   CHECK_THROWS_AS(io::writeMap(dir / "no-such-dir" / "map.mlmap", smallRoomMap(false)), Error);
   CHECK(test::readText(dir / "map.mlmap") == before);
+}
+
+TEST_CASE("MapFile: a labelled map keeps its planes, and version-1 files still read") {
+  const test::TempDir dir;
+  Map map = smallRoomMap(false);
+  PlaneDetection detection;
+  Plane plane;
+  plane.id = 7;
+  plane.label = PlaneClass::Floor;
+  plane.offset = 0.0;
+  plane.area = 2.5;
+  plane.block_count = 1;
+  plane.source = 1;
+  plane.outline = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}};
+  detection.planes.push_back(plane);
+  detection.stats.candidates = 42;
+  detection.config.seed = 9;
+  map.setPlanes(detection);
+  io::writeMap(dir / "labelled.mlmap", map);
+  const Map back = io::readMap(dir / "labelled.mlmap");
+  REQUIRE(back.planes().has_value());
+  REQUIRE(back.planes()->planes.size() == 1);
+  const Plane& read = back.planes()->planes[0];
+  CHECK(read.id == 7);
+  CHECK(read.label == PlaneClass::Floor);
+  CHECK(read.area == doctest::Approx(2.5));
+  CHECK(read.outline.size() == 3);
+  CHECK(back.planes()->stats.candidates == 42);
+  CHECK(back.planes()->config.seed == 9);
+  CHECK(back.blocks().blocksAt(0)[0].plane == 7);
+
+  // A version-1 file is the version-2 layout without planes: rewrite the version byte
+  // of an unlabelled map and fix its checksum.
+  Map unlabelled = smallRoomMap(false);
+  io::writeMap(dir / "v2.mlmap", unlabelled);
+  std::string bytes = test::readText(dir / "v2.mlmap");
+  bytes[8] = 1;
+  bytes.resize(bytes.size() - 4);
+  const std::uint32_t crc = io::crc32(bytes.data(), bytes.size());
+  bytes.append(reinterpret_cast<const char*>(&crc), sizeof(crc));
+  test::writeText(dir / "v1.mlmap", bytes);
+  const Map old = io::readMap(dir / "v1.mlmap");
+  CHECK_FALSE(old.planes().has_value());
+  CHECK(old.blocks().blockCount() == unlabelled.blocks().blockCount());
+
+  // New scans invalidate the labels.
+  Map changed = io::readMap(dir / "labelled.mlmap");
+  Scan scan;
+  scan.points.emplace_back(0.5, 0.5, 0.0);
+  changed.insertScan(scan);
+  CHECK_FALSE(changed.planes().has_value());
+  CHECK(changed.blocks().stats().labelled_blocks == 0);
 }

@@ -64,3 +64,71 @@ TEST_CASE("PlanesJson: a failed write leaves no file") {
   CHECK_THROWS_AS(io::writePlanesJson(dir / "missing" / "p.json", map, detectPlanes(map.blocks()), "m"), Error);
   CHECK(std::filesystem::is_empty(dir.path()));
 }
+
+TEST_CASE("PlanesJson: an export reads back to the same planes") {
+  test::PlaneSceneBuilder scene(0.05);
+  scene.floor(0.0, 0.0, 4.0, 3.0, 0.0).wallX(0.0, 0.0, 3.0, 0.0, 2.6);
+  Map map(MapConfig{0.05, 0.0, -1.0, false});
+  map.blocks() = scene.map();
+  const PlaneDetection detection = detectPlanes(map.blocks());
+  REQUIRE(detection.planes.size() >= 2);
+  const PlaneDetection back = io::parsePlanesJson(io::planesJson(map, detection, "room.mlmap"), "room.json");
+  REQUIRE(back.planes.size() == detection.planes.size());
+  for (std::size_t k = 0; k < back.planes.size(); ++k) {
+    const Plane& expected = detection.planes[k];
+    const Plane& read = back.planes[k];
+    CHECK(read.id == expected.id);
+    CHECK(read.label == expected.label);
+    CHECK((read.normal - expected.normal).norm() < 1e-12);
+    CHECK(read.offset == doctest::Approx(expected.offset));
+    CHECK(read.area == doctest::Approx(expected.area));
+    CHECK(read.block_count == expected.block_count);
+    CHECK(read.outline.size() == expected.outline.size());
+    CHECK(read.source == expected.source);
+  }
+  CHECK(back.stats.candidates == detection.stats.candidates);
+  CHECK(back.config.kappa_deg == detection.config.kappa_deg);
+  CHECK(back.config.seed == detection.config.seed);
+}
+
+TEST_CASE("PlanesJson: the reader refuses what is not an export, naming the element") {
+  test::PlaneSceneBuilder scene(0.05);
+  scene.floor(0.0, 0.0, 3.0, 3.0, 0.0);
+  Map map(MapConfig{0.05, 0.0, -1.0, false});
+  map.blocks() = scene.map();
+  const nlohmann::json good = nlohmann::json::parse(io::planesJson(map, detectPlanes(map.blocks()), "f.mlmap"));
+  REQUIRE_FALSE(good["planes"].empty());
+  const auto refused = [](const nlohmann::json& json, const char* fragment) {
+    CHECK_THROWS_WITH_AS(io::parsePlanesJson(json.dump(), "x.json"), doctest::Contains(fragment), Error);
+  };
+  CHECK_THROWS_WITH_AS(io::parsePlanesJson("{\"schema\": ", "x.json"), doctest::Contains("x.json: not valid JSON"),
+                       Error);
+  CHECK_THROWS_WITH_AS(io::parsePlanesJson("[1, 2]", "x.json"), doctest::Contains("expected an object"), Error);
+  nlohmann::json json = good;
+  json["schema"] = "mlmap.planes/2";
+  refused(json, "schema");
+  json = good;
+  json["planes"][0]["normal"] = {0.0, 1.0};
+  refused(json, "planes[0].normal: expected 3 numbers");
+  json = good;
+  json["planes"][0]["normal"] = {0.0, 2.0, 0.0};
+  refused(json, "not a unit vector");
+  json = good;
+  json["planes"][0]["id"] = -4;
+  refused(json, "planes[0].id: out of range");
+  json = good;
+  json["planes"][0]["label"] = "roof";
+  refused(json, "planes[0].label");
+  json = good;
+  json["planes"][0]["outline"][0] = {1.0, "a", 2.0};
+  refused(json, "planes[0].outline[0][1]: expected a number");
+  json = good;
+  json["planes"].push_back(json["planes"][0]);
+  refused(json, "appears twice");
+  json = good;
+  json["parameters"].erase("seed");
+  refused(json, "parameters: missing \"seed\"");
+  json = good;
+  json["timings"]["detection_s"] = "fast";
+  refused(json, "timings.detection_s");
+}

@@ -13,6 +13,7 @@
 #include "crc32.hpp"
 #include "file_bytes.hpp"
 #include "mlmap/error.hpp"
+#include "mlmap/io/planes_json.hpp"
 
 namespace mlmap::io {
 namespace {
@@ -21,6 +22,8 @@ static_assert(std::endian::native == std::endian::little, "the .mlmap codec assu
 
 constexpr char kMagic[8] = {'\x89', 'M', 'L', 'M', 'A', 'P', '\r', '\n'};
 constexpr std::uint32_t kHasOctree = 1U;
+constexpr std::uint32_t kHasPlanes = 2U;
+constexpr std::uint32_t kOldestReadableVersion = 1;
 constexpr std::size_t kBlockBytes = 17;
 constexpr std::size_t kCellHeaderBytes = 10;
 
@@ -81,7 +84,7 @@ void writeMap(const std::filesystem::path& path, const Map& map) {
   out.reserve(64 + blocks.cellCount() * kCellHeaderBytes + blocks.blockCount() * kBlockBytes);
   out.append(kMagic, sizeof(kMagic));
   put<std::uint32_t>(out, kMapFileVersion);
-  put<std::uint32_t>(out, map.hasOctree() ? kHasOctree : 0U);
+  put<std::uint32_t>(out, (map.hasOctree() ? kHasOctree : 0U) | (map.planes() ? kHasPlanes : 0U));
   put<double>(out, config.cell_size);
   put<double>(out, config.octree_resolution);
   put<double>(out, config.max_range);
@@ -113,6 +116,11 @@ void writeMap(const std::filesystem::path& path, const Map& map) {
   }
   put<std::uint64_t>(out, octree_bytes.size());
   out += octree_bytes;
+  if (map.planes()) {
+    const std::string planes = planesJson(map, *map.planes(), path.filename().string());
+    put<std::uint64_t>(out, planes.size());
+    out += planes;
+  }
   put<std::uint32_t>(out, crc32(out.data(), out.size()));
   writeWholeFile(path, out);
 }
@@ -126,9 +134,10 @@ Map readMap(const std::filesystem::path& path) {
   ByteReader header(bytes, bytes.size(), name);
   header.take(sizeof(kMagic), "the magic number");
   const auto version = header.get<std::uint32_t>("the version");
-  if (version != kMapFileVersion) {
-    header.failAt(8, "format version " + std::to_string(version) + ", this mlmap reads version " +
-                         std::to_string(kMapFileVersion) + " (rebuild the map with this mlmap)");
+  if (version < kOldestReadableVersion || version > kMapFileVersion) {
+    header.failAt(8, "format version " + std::to_string(version) + ", this mlmap reads versions " +
+                         std::to_string(kOldestReadableVersion) + " to " + std::to_string(kMapFileVersion) +
+                         (version > kMapFileVersion ? " (a newer mlmap wrote it)" : ""));
   }
   if (bytes.size() < header.offset() + sizeof(std::uint32_t)) {
     header.fail("file too short for a checksum");
@@ -148,6 +157,10 @@ Map readMap(const std::filesystem::path& path) {
   config.octree_resolution = in.get<double>("the OcTree resolution");
   config.max_range = in.get<double>("the maximum range");
   config.with_octree = (flags & kHasOctree) != 0;
+  const bool has_planes = (flags & kHasPlanes) != 0;
+  if ((flags & ~(kHasOctree | kHasPlanes)) != 0 || (has_planes && version < 2)) {
+    in.failAt(12, "unknown flags " + std::to_string(flags));
+  }
   if (!(config.cell_size > 0.0 && config.cell_size < 1e3) ||
       (config.with_octree && !(config.octree_resolution > 0.0 && config.octree_resolution < 1e3))) {
     in.failAt(16, "cell size or OcTree resolution out of range");
@@ -190,7 +203,7 @@ Map readMap(const std::filesystem::path& path) {
             std::to_string(blocks_seen));
   }
   const auto octree_size = in.get<std::uint64_t>("the OcTree size");
-  if (octree_size != in.remaining()) {
+  if (has_planes ? octree_size > in.remaining() : octree_size != in.remaining()) {
     in.fail("the OcTree claims " + std::to_string(octree_size) + " bytes, " +
             std::to_string(in.remaining()) + " remain");
   }
@@ -211,6 +224,19 @@ Map readMap(const std::filesystem::path& path) {
     }
   } else if (octree_size != 0) {
     in.fail("an OcTree follows but the flags say none");
+  }
+  if (has_planes) {
+    const auto planes_size = in.get<std::uint64_t>("the planes size");
+    if (planes_size != in.remaining()) {
+      in.fail("the planes claim " + std::to_string(planes_size) + " bytes, " + std::to_string(in.remaining()) +
+              " remain");
+    }
+    const std::size_t planes_offset = in.offset();
+    try {
+      map.setPlanes(parsePlanesJson(in.take(planes_size, "the planes"), "the planes"));
+    } catch (const Error& error) {
+      in.failAt(planes_offset, error.what());
+    }
   }
   map.blocks().compact();
   return map;

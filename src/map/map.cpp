@@ -75,7 +75,17 @@ void Map::insertScan(const Scan& scan) {
   insertIntoOctree(scan);
 }
 
-void Map::insertIntoBlocks(const Scan& scan) { blocks_.insertScan(scan); }
+void Map::insertIntoBlocks(const Scan& scan) {
+  if (planes_) clearPlanes();
+  blocks_.insertScan(scan);
+}
+
+void Map::clearPlanes() {
+  planes_.reset();
+  for (std::size_t n = 0; n < blocks_.cellCount(); ++n) {
+    for (Block& block : blocks_.mutableBlocksAt(n)) block.plane = 0;
+  }
+}
 
 void Map::insertIntoOctree(const Scan& scan) {
   if (!octree_) return;

@@ -3,11 +3,12 @@
 //
 //   magic      8 bytes  "\x89MLMAP\r\n" (binary-safe, like PNG's)
 //   version    u32      kMapFileVersion
-//   flags      u32      bit 0: an OcTree follows
+//   flags      u32      bit 0: an OcTree follows, bit 1: planes follow (version ≥ 2)
 //   cell_size, octree_resolution, max_range   f64 each, metres
 //   cell_count u64, block_count u64
 //   per cell:  i i32, j i32, n u16, then n blocks: h f32, σ f32, d f32, π i32, kind u8
 //   octree     u64 byte count, then OcTree::write() output (.ot stream)
+//   planes     u64 byte count, then the planes JSON (mlmap.planes/1) the labels refer to
 //   crc32      u32 over every byte before it
 // All numbers little-endian.
 #pragma once
@@ -19,7 +20,7 @@
 
 namespace mlmap::io {
 
-constexpr std::uint32_t kMapFileVersion = 1;
+constexpr std::uint32_t kMapFileVersion = 2;  // 1: no planes section; still read
 
 // Written to a temporary file and renamed: a failure leaves any old file untouched.
 void writeMap(const std::filesystem::path& path, const Map& map);

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 #include "mlmap/map/map.hpp"
 #include "mlmap/planes/ermsm.hpp"
@@ -19,5 +20,11 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
 // Written atomically.
 void writePlanesJson(const std::filesystem::path& path, const Map& map, const PlaneDetection& detection,
                      const std::string& source_name);
+
+// Reads an export back: the planes with their parameters and run figures (the map's
+// own metadata is the map's, not kept). Input is untrusted: anything off the schema
+// throws mlmap::Error naming `name` and the element, e.g. "x.json: planes[3].normal: ...".
+PlaneDetection parsePlanesJson(std::string_view text, const std::string& name);
+PlaneDetection readPlanesJson(const std::filesystem::path& path);
 
 }  // namespace mlmap::io

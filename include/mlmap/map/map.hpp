@@ -3,10 +3,12 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 
 #include <octomap/OcTree.h>
 
 #include "mlmap/map/ml_map.hpp"
+#include "mlmap/planes/ermsm.hpp"
 #include "mlmap/scan.hpp"
 
 namespace mlmap {
@@ -41,10 +43,19 @@ class Map {
   // Replaces the OcTree (map readers); its resolution must match the config's.
   void setOctree(std::unique_ptr<octomap::OcTree> octree);
 
+  // The planes its blocks' labels refer to, once detected (mlmap planes). Kept with
+  // the map so exports need no second detection run.
+  const std::optional<PlaneDetection>& planes() const { return planes_; }
+  void setPlanes(PlaneDetection planes) { planes_ = std::move(planes); }
+  // Forgets the planes and clears every block's label: blocks that changed (new
+  // scans, a merge) would otherwise carry labels of planes no longer there.
+  void clearPlanes();
+
  private:
   MapConfig config_;
   MLMap blocks_;
   std::unique_ptr<octomap::OcTree> octree_;
+  std::optional<PlaneDetection> planes_;
 };
 
 }  // namespace mlmap
