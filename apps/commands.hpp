@@ -23,6 +23,8 @@ void addLabelCommand(CLI::App& app, Context& context);
 void addScanCommand(CLI::App& app, Context& context);
 void addReplayCommand(CLI::App& app, Context& context);
 void addEmulateCommand(CLI::App& app, Context& context);
+void addExportCommand(CLI::App& app, Context& context);
+void addMergeCommand(CLI::App& app, Context& context);
 
 inline void addCommands(CLI::App& app, Context& context) {
   addSimulateCommand(app, context);
@@ -32,6 +34,8 @@ inline void addCommands(CLI::App& app, Context& context) {
   addCalibrateCommand(app, context);
   addPlanesCommand(app, context);
   addLabelCommand(app, context);
+  addMergeCommand(app, context);
+  addExportCommand(app, context);
   addScanCommand(app, context);
   addReplayCommand(app, context);
   addEmulateCommand(app, context);

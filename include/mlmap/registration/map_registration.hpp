@@ -1,0 +1,39 @@
+// Registering one map onto another (for merging adjacent rooms): ICP between the
+// surfaces the two maps' blocks describe, nearest neighbours from the OcTree key grid.
+// The result says how far the maps overlap and whether the match can be trusted.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mlmap/map/map.hpp"
+#include "mlmap/registration/icp.hpp"
+
+namespace mlmap::registration {
+
+struct MapRegistrationConfig {
+  double initial_max_distance = 0.5;  // m, correspondence gate at the first ICP iteration
+  double overlap_distance = 0.0;      // m, a point overlaps within this of the base; 0 = 2 cells, at least 0.1
+  double min_overlap = 0.01;          // fraction of the other map's surface samples; less: unreliable
+  std::size_t min_inliers = 200;
+};
+
+struct MapRegistration {
+  Pose other_to_base = Pose::Identity();
+  double rms_residual = 0.0;   // m
+  double overlap = 0.0;        // fraction of the other map's surface samples near the base's
+  std::size_t inliers = 0;
+  std::size_t samples = 0;     // surface samples of the other map used
+  bool degenerate = false;
+  bool reliable = false;
+  std::string reason;          // why not reliable; empty when reliable
+};
+
+// Surface samples of a map's blocks: a horizontal block's point, and a vertical
+// block's extent every `spacing` metres, at its cell centre.
+std::vector<Point> blockSurfacePoints(const MLMap& blocks, double spacing);
+
+MapRegistration registerMaps(const Map& base, const Map& other, const Pose& initial_guess,
+                             const MapRegistrationConfig& config = {});
+
+}  // namespace mlmap::registration

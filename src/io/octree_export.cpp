@@ -1,0 +1,126 @@
+#include "mlmap/io/octree_export.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "captured_cerr.hpp"
+#include "mlmap/error.hpp"
+#include "mlmap/io/atomic_file.hpp"
+#include "mlmap/io/palette.hpp"
+
+namespace mlmap::io {
+namespace {
+
+// The plane label of the block a voxel lies in: the block nearest in height among
+// the cells under the voxel's footprint, within a cell of its extent.
+std::int32_t planeAt(const MLMap& blocks, const Eigen::Vector3d& centre, double voxel_size) {
+  const double cell_size = blocks.cellSize();
+  const double half = std::max(voxel_size, cell_size) / 2.0;
+  const double reach = std::max(voxel_size / 2.0, cell_size);
+  std::int32_t label = 0;
+  double best = std::numeric_limits<double>::infinity();
+  // At most 2 x 2 samples of the footprint: enough to reach a wall's cells when the
+  // voxel is coarser than the cells.
+  const double step = std::max(cell_size, half);
+  for (double dy = -half + step / 2.0; dy < half; dy += step) {
+    for (double dx = -half + step / 2.0; dx < half; dx += step) {
+      const auto cell = blocks.findCellOf(centre.x() + dx, centre.y() + dy);
+      if (!cell) continue;
+      for (const Block& block : blocks.blocks(*cell)) {
+        const double below = block.bottom() - centre.z();
+        const double above = centre.z() - block.height;
+        const double gap = std::max({below, above, 0.0});
+        // Labelled blocks win ties: a wall voxel at a floor's edge shows the wall.
+        const double score = gap - (block.plane != 0 ? 1e-6 : 0.0);
+        if (gap <= reach && score < best) {
+          best = score;
+          label = block.plane;
+        }
+      }
+    }
+  }
+  return label;
+}
+
+void addVoxel(octomap::ColorOcTree& tree, const MLMap& blocks, const octomap::point3d& centre, float log_odds) {
+  octomap::OcTreeKey key;
+  if (!tree.coordToKeyChecked(centre, key)) return;
+  tree.setNodeValue(key, log_odds, true);
+  const Rgb colour = planeColour(planeAt(blocks, Eigen::Vector3d(centre.x(), centre.y(), centre.z()),
+                                         tree.getResolution()));
+  tree.setNodeColor(key, colour.red, colour.green, colour.blue);
+}
+
+void voxelsFromOctree(octomap::ColorOcTree& tree, const Map& map) {
+  const octomap::OcTree& source = map.octree();
+  const double resolution = source.getResolution();
+  for (auto leaf = source.begin_leafs(), end = source.end_leafs(); leaf != end; ++leaf) {
+    if (!source.isNodeOccupied(*leaf)) continue;
+    const float log_odds = leaf->getLogOdds();
+    // A pruned occupied leaf stands for all the voxels inside it.
+    const int per_axis = static_cast<int>(std::lround(leaf.getSize() / resolution));
+    const octomap::point3d corner = leaf.getCoordinate() - octomap::point3d(1, 1, 1) * (leaf.getSize() / 2.0F);
+    for (int a = 0; a < per_axis; ++a) {
+      for (int b = 0; b < per_axis; ++b) {
+        for (int c = 0; c < per_axis; ++c) {
+          const octomap::point3d offset(static_cast<float>((a + 0.5) * resolution),
+                                        static_cast<float>((b + 0.5) * resolution),
+                                        static_cast<float>((c + 0.5) * resolution));
+          addVoxel(tree, map.blocks(), corner + offset, log_odds);
+        }
+      }
+    }
+  }
+}
+
+void voxelsFromBlocks(octomap::ColorOcTree& tree, const MLMap& blocks) {
+  const double resolution = tree.getResolution();
+  const float occupied = tree.getClampingThresMaxLog();
+  for (std::size_t n = 0; n < blocks.cellCount(); ++n) {
+    const Eigen::Vector2d xy = blocks.cellCenter(blocks.cellAt(n));
+    for (const Block& block : blocks.blocksAt(n)) {
+      const auto steps = static_cast<int>(std::floor(block.depth / resolution));
+      for (int k = 0; k <= steps; ++k) {
+        const double z = block.height - k * resolution;
+        addVoxel(tree, blocks,
+                 octomap::point3d(static_cast<float>(xy.x()), static_cast<float>(xy.y()), static_cast<float>(z)),
+                 occupied);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<octomap::ColorOcTree> colouredOctree(const Map& map) {
+  const double resolution = map.hasOctree() ? map.octree().getResolution() : map.config().cell_size;
+  auto tree = std::make_unique<octomap::ColorOcTree>(resolution);
+  if (map.hasOctree()) {
+    voxelsFromOctree(*tree, map);
+  } else {
+    voxelsFromBlocks(*tree, map.blocks());
+  }
+  // Inner nodes get their children's maximum occupancy and mean colour, so octovis
+  // shows coarser levels of detail in the right colours.
+  tree->updateInnerOccupancy();
+  return tree;
+}
+
+void writeColouredOctree(const std::filesystem::path& path, const Map& map) {
+  const std::unique_ptr<octomap::ColorOcTree> tree = colouredOctree(map);
+  writeAtomically(path, [&](std::ostream& out) {
+    const CapturedCerr quiet;
+    if (!tree->write(out)) throw Error("OctoMap could not write the ColorOcTree");
+  });
+}
+
+void writeBinaryOctree(const std::filesystem::path& path, const Map& map) {
+  if (!map.hasOctree()) throw Error(path.string() + ": the map has no OcTree (it was built with --no-octree)");
+  writeAtomically(path, [&](std::ostream& out) {
+    const CapturedCerr quiet;
+    if (!map.octree().writeBinaryConst(out)) throw Error("OctoMap could not write the OcTree");
+  });
+}
+
+}  // namespace mlmap::io
