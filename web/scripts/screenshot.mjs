@@ -1,0 +1,45 @@
+#!/usr/bin/env node
+// Renders the built dashboard (dist/index.html) with a planes JSON and saves a screenshot.
+// Usage: node scripts/screenshot.mjs PLANES.json OUT.png [WIDTHxHEIGHT]
+// Needs `npm run build` first and /usr/bin/chromium (or CHROMIUM=path).
+import { copyFile, mkdir, mkdtemp, readFile, rm, writeFile } from 'node:fs/promises';
+import { existsSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import path from 'node:path';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+import { launchChromium, planesJs } from './browser.mjs';
+
+const [input, out, size = '1600x1000'] = process.argv.slice(2);
+if (!input || !out) {
+  console.error('usage: node scripts/screenshot.mjs PLANES.json OUT.png [WIDTHxHEIGHT]');
+  process.exit(2);
+}
+const [width, height] = size.split('x').map(Number);
+const dist = path.join(path.dirname(fileURLToPath(import.meta.url)), '..', 'dist', 'index.html');
+if (!existsSync(dist)) {
+  console.error(`${dist} is missing: run npm run build in web/ first`);
+  process.exit(1);
+}
+
+const dir = await mkdtemp(path.join(tmpdir(), 'mlmap-web-shot-'));
+const browser = await launchChromium();
+try {
+  // The page as `mlmap export --dashboard` lays it out: index.html with planes.js beside it.
+  await copyFile(dist, path.join(dir, 'index.html'));
+  await writeFile(path.join(dir, 'planes.js'), planesJs(await readFile(input, 'utf8')));
+  const page = await browser.context.newPage();
+  await page.setViewportSize({ width, height });
+  await page.goto(pathToFileURL(path.join(dir, 'index.html')).href);
+  await page.waitForFunction(() => ['ready', 'error'].includes(document.body.dataset.state));
+  if ((await page.getAttribute('body', 'data-state')) !== 'ready') {
+    throw new Error(`the dashboard did not load ${input}: ${await page.textContent('#message')}`);
+  }
+  await page.waitForTimeout(300);
+  await mkdir(path.dirname(path.resolve(out)), { recursive: true });
+  await page.screenshot({ path: out });
+  console.log(`wrote ${out}`);
+} finally {
+  await browser.context.close();
+  await rm(browser.userDataDir, { recursive: true, force: true });
+  await rm(dir, { recursive: true, force: true });
+}
