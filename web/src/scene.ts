@@ -84,7 +84,9 @@ export class PlanesView {
     axes.position.copy(min);
     this.content.add(grid, bounds, axes);
 
+    const drawn = new THREE.Box3();
     for (const patch of data.planes) {
+      for (const q of patch.outline) drawn.expandByPoint(new THREE.Vector3(q[0], q[1], q[2]));
       const geometry = fillGeometry(patch);
       const fill = new THREE.Mesh(geometry ?? new THREE.BufferGeometry(), new THREE.MeshLambertMaterial({
         side: THREE.DoubleSide, transparent: true, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
@@ -97,7 +99,7 @@ export class PlanesView {
       this.content.add(fill, edge);
       this.patches.set(patch.id, { patch, fill, edge });
     }
-    this.fit(box);
+    this.fit(drawn.isEmpty() ? box : drawn);
     this.restyle();
   }
 
@@ -181,14 +183,32 @@ export class PlanesView {
     this.render();
   }
 
+  /** Frames the box: the nearest camera distance, looking from the south-west and above, at
+   * which all its corners land inside the view. */
   private fit(box: THREE.Box3): void {
+    this.resize();
     const centre = box.getCenter(new THREE.Vector3());
-    const radius = Math.max(1, box.getSize(new THREE.Vector3()).length() / 2);
-    const distance = radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2));
+    const radius = Math.max(0.5, box.getSize(new THREE.Vector3()).length() / 2);
+    const corners = [0, 1, 2, 3, 4, 5, 6, 7].map((i) => new THREE.Vector3(
+      i & 1 ? box.max.x : box.min.x, i & 2 ? box.max.y : box.min.y, i & 4 ? box.max.z : box.min.z));
     const direction = new THREE.Vector3(-0.45, -0.75, 0.9).normalize();
-    this.camera.position.copy(centre).addScaledVector(direction, distance * 1.05);
-    this.camera.near = distance / 200;
-    this.camera.far = distance * 10;
+    const fits = (distance: number) => {
+      this.camera.position.copy(centre).addScaledVector(direction, distance);
+      this.camera.lookAt(centre);
+      this.camera.updateMatrixWorld();
+      return corners.every((c) => {
+        const p = c.clone().project(this.camera);
+        return Math.abs(p.x) <= 0.94 && Math.abs(p.y) <= 0.92;
+      });
+    };
+    let near = radius * 1.01, far = radius * 50;
+    for (let i = 0; i < 40; i++) {
+      const mid = (near + far) / 2;
+      if (fits(mid)) far = mid; else near = mid;
+    }
+    this.camera.position.copy(centre).addScaledVector(direction, far);
+    this.camera.near = Math.max(0.01, far / 500);
+    this.camera.far = (far + radius) * 10;
     this.camera.updateProjectionMatrix();
     this.controls.target.copy(centre);
     this.controls.update();
