@@ -78,7 +78,7 @@ function show(loaded: Loaded): void {
   filterInput.value = '';
   $('origin').textContent = `${loaded.origin} · ${data.planes.length} patches`;
   document.title = `mlmap planes · ${loaded.origin}`;
-  setState('ready');
+  setState('ready'); // first, so the view has its final width when it frames the map
   renderSummary($('summary'), data, (classes) => { shownClasses = classes; applyFilter(); });
   table.setData(data.planes);
   table.setColourMode(colourSelect.value as ColourMode);
