@@ -1,5 +1,6 @@
-// Scene JSON loader: every element is read through a JsonNode that knows its path, so
-// each error names the file and the element ("lab.json: surfaces[3].size: ...").
+// Scene JSON loader, one file's own elements: every element is read through a JsonNode
+// that knows its path, so each error names the file and the element ("lab.json:
+// surfaces[3].size: ..."). Includes and openings: scene_include.cpp.
 #include "mlmap/sim/scene.hpp"
 
 #include <algorithm>
@@ -12,123 +13,15 @@
 #include <sstream>
 
 #include "mlmap/error.hpp"
+#include "scene_loader.hpp"
 
 namespace mlmap::sim {
 namespace {
 
 using nlohmann::json;
+using detail::JsonNode;
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
-
-// A JSON value with the path that led to it, for messages.
-class JsonNode {
- public:
-  JsonNode(const json& value, std::string path, const std::string& source)
-      : value_(value), path_(std::move(path)), source_(source) {}
-
-  [[noreturn]] void fail(const std::string& what) const {
-    throw Error(source_ + ": " + (path_.empty() ? std::string("(top level)") : path_) + ": " +
-                what);
-  }
-
-  const json& value() const { return value_; }
-  const std::string& path() const { return path_; }
-
-  bool has(const std::string& key) const { return value_.contains(key); }
-
-  JsonNode operator[](const std::string& key) const {
-    if (!value_.contains(key)) JsonNode(value_, join(key), source_).fail("missing");
-    return JsonNode(value_.at(key), join(key), source_);
-  }
-  JsonNode operator[](std::size_t index) const {
-    return JsonNode(value_.at(index), path_ + "[" + std::to_string(index) + "]", source_);
-  }
-
-  void expectObject() const {
-    if (!value_.is_object()) fail("expected an object");
-  }
-  std::size_t arraySize() const {
-    if (!value_.is_array()) fail("expected an array");
-    return value_.size();
-  }
-
-  // Unknown keys are typos more often than not; keys starting with '_' are comments.
-  void allowOnly(std::initializer_list<std::string_view> keys) const {
-    expectObject();
-    for (const auto& item : value_.items()) {
-      const std::string& key = item.key();
-      if (!key.empty() && key.front() == '_') continue;
-      if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
-        JsonNode(item.value(), join(key), source_).fail("unknown field");
-      }
-    }
-  }
-
-  double number() const {
-    if (!value_.is_number()) fail("expected a number");
-    const double result = value_.get<double>();
-    if (!std::isfinite(result)) fail("expected a finite number");
-    return result;
-  }
-  double positive() const {
-    const double result = number();
-    if (!(result > 0.0)) fail("must be positive");
-    return result;
-  }
-  double nonNegative() const {
-    const double result = number();
-    if (result < 0.0) fail("must not be negative");
-    return result;
-  }
-  std::int64_t integer() const {
-    if (!value_.is_number_integer()) fail("expected an integer");
-    return value_.get<std::int64_t>();
-  }
-  std::uint64_t unsignedInteger() const {
-    if (!value_.is_number_unsigned()) fail("expected a non-negative integer");
-    return value_.get<std::uint64_t>();
-  }
-  std::string string() const {
-    if (!value_.is_string()) fail("expected a string");
-    return value_.get<std::string>();
-  }
-  std::vector<double> numbers(std::size_t count) const {
-    if (!value_.is_array() || value_.size() != count) {
-      fail("expected " + std::to_string(count) + " numbers");
-    }
-    std::vector<double> result;
-    for (std::size_t i = 0; i < count; ++i) result.push_back((*this)[i].number());
-    return result;
-  }
-  Eigen::Vector3d vector3() const {
-    const auto v = numbers(3);
-    return {v[0], v[1], v[2]};
-  }
-  Eigen::Vector2d vector2() const {
-    const auto v = numbers(2);
-    return {v[0], v[1]};
-  }
-
-  double numberOr(const std::string& key, double fallback) const {
-    return has(key) ? (*this)[key].number() : fallback;
-  }
-  double positiveOr(const std::string& key, double fallback) const {
-    return has(key) ? (*this)[key].positive() : fallback;
-  }
-  double nonNegativeOr(const std::string& key, double fallback) const {
-    return has(key) ? (*this)[key].nonNegative() : fallback;
-  }
-  std::string stringOr(const std::string& key, const std::string& fallback) const {
-    return has(key) ? (*this)[key].string() : fallback;
-  }
-
- private:
-  std::string join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-
-  const json& value_;
-  std::string path_;
-  const std::string& source_;
-};
 
 // A surface before plane ids are assigned.
 struct PendingSurface {
@@ -489,39 +382,6 @@ void assignPlanes(SceneBuilder& builder, Scene& scene, const std::string& source
   for (auto& [id, plane] : planes) scene.ground_truth.push_back(std::move(plane));
 }
 
-Scene parseJson(const json& document, const std::string& source) {
-  const JsonNode root(document, "", source);
-  root.allowOnly({"name", "scan_pattern", "odometry", "poses", "surfaces"});
-  Scene scene;
-  scene.name = root.stringOr("name", "");
-  if (root.has("scan_pattern")) scene.pattern = parsePattern(root["scan_pattern"]);
-  if (root.has("odometry")) scene.odometry = parseOdometry(root["odometry"]);
-
-  const JsonNode poses = root["poses"];
-  if (poses.arraySize() == 0) poses.fail("expected at least one pose");
-  for (std::size_t i = 0; i < poses.arraySize(); ++i) {
-    const JsonNode pose = poses[i];
-    pose.allowOnly({"x", "y", "yaw_deg"});
-    scene.poses.push_back({pose["x"].number(), pose["y"].number(), pose.numberOr("yaw_deg", 0.0)});
-  }
-
-  SceneBuilder builder;
-  const JsonNode surfaces = root["surfaces"];
-  for (std::size_t i = 0; i < surfaces.arraySize(); ++i) {
-    const JsonNode surface = surfaces[i];
-    surface.expectObject();
-    const std::string type = surface["type"].string();
-    if (type == "rectangle") parseRectangle(surface, builder);
-    else if (type == "box") parseBox(surface, builder);
-    else if (type == "stairs") parseStairs(surface, builder);
-    else if (type == "cylinder") parseCylinder(surface, scene);
-    else surface["type"].fail("unknown type \"" + type + "\" (rectangle, box, stairs, cylinder)");
-  }
-  if (builder.surfaces.empty()) surfaces.fail("expected at least one planar surface");
-  assignPlanes(builder, scene, source);
-  return scene;
-}
-
 }  // namespace
 
 std::string_view className(SurfaceClass surface_class) {
@@ -580,27 +440,79 @@ std::optional<GroundTruthPlane> Scene::plane(std::int32_t id) const {
   return *found;
 }
 
-Scene parseScene(std::string_view json_text, const std::string& source_name) {
-  json document;
+namespace detail {
+
+Scene parseSceneElements(const JsonNode& root, bool poses_required, bool surfaces_required) {
+  Scene scene;
+  scene.name = root.stringOr("name", "");
+  if (root.has("scan_pattern")) scene.pattern = parsePattern(root["scan_pattern"]);
+  if (root.has("odometry")) scene.odometry = parseOdometry(root["odometry"]);
+
+  if (poses_required || root.has("poses")) {
+    const JsonNode poses = root["poses"];
+    if (poses.arraySize() == 0) poses.fail("expected at least one pose");
+    for (std::size_t i = 0; i < poses.arraySize(); ++i) {
+      const JsonNode pose = poses[i];
+      pose.allowOnly({"x", "y", "yaw_deg"});
+      scene.poses.push_back({pose["x"].number(), pose["y"].number(), pose.numberOr("yaw_deg", 0.0)});
+    }
+  }
+
+  SceneBuilder builder;
+  if (surfaces_required || root.has("surfaces")) {
+    const JsonNode surfaces = root["surfaces"];
+    for (std::size_t i = 0; i < surfaces.arraySize(); ++i) {
+      const JsonNode surface = surfaces[i];
+      surface.expectObject();
+      const std::string type = surface["type"].string();
+      if (type == "rectangle") parseRectangle(surface, builder);
+      else if (type == "box") parseBox(surface, builder);
+      else if (type == "stairs") parseStairs(surface, builder);
+      else if (type == "cylinder") parseCylinder(surface, scene);
+      else surface["type"].fail("unknown type \"" + type + "\" (rectangle, box, stairs, cylinder)");
+    }
+    if (builder.surfaces.empty() && surfaces_required) surfaces.fail("expected at least one planar surface");
+  }
+  assignPlanes(builder, scene, root.source());
+  return scene;
+}
+
+nlohmann::json parseSceneDocument(std::string_view json_text, const std::string& source) {
   try {
-    document = json::parse(json_text.begin(), json_text.end());
+    return json::parse(json_text.begin(), json_text.end());
   } catch (const json::parse_error& error) {
     // nlohmann's message reads "[json.exception.parse_error.101] parse error at line 3, ..."
     std::string what = error.what();
     const auto bracket = what.find("] ");
     if (bracket != std::string::npos) what = what.substr(bracket + 2);
-    throw Error(source_name + ": " + what);
+    throw Error(source + ": " + what);
   }
-  return parseJson(document, source_name);
 }
 
-Scene loadScene(const std::filesystem::path& path) {
+nlohmann::json readSceneDocument(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open scene file");
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw Error(path.string() + ": read error");
-  return parseScene(text.str(), path.string());
+  return parseSceneDocument(text.str(), path.string());
+}
+
+}  // namespace detail
+
+// Includes resolve against the directory of `source_name`.
+Scene parseScene(std::string_view json_text, const std::string& source_name) {
+  detail::IncludeChain chain;
+  const auto document = detail::parseSceneDocument(json_text, source_name);
+  return detail::assembleScene(document, source_name, std::filesystem::path(source_name).parent_path(), chain, true)
+      .scene;
+}
+
+Scene loadScene(const std::filesystem::path& path) {
+  std::error_code ignored;
+  detail::IncludeChain chain = {std::filesystem::weakly_canonical(path, ignored)};
+  return detail::assembleScene(detail::readSceneDocument(path), path.string(), path.parent_path(), chain, true)
+      .scene;
 }
 
 }  // namespace mlmap::sim

@@ -105,9 +105,12 @@ struct Scene {
 };
 
 // Throws mlmap::Error naming the file and the JSON element ("lab.json: surfaces[3].size:
-// expected 3 numbers") on any bad or missing field.
+// expected 3 numbers") on any bad or missing field. Includes are placed and openings cut
+// (placement.hpp, openings.hpp); the scene is in the frame of the scene that
+// provides the poses.
 Scene loadScene(const std::filesystem::path& path);
-// Same from text; `source_name` stands for the file in messages.
+// Same from text; `source_name` stands for the file in messages, and includes resolve
+// against its directory.
 Scene parseScene(std::string_view json_text, const std::string& source_name);
 
 }  // namespace mlmap::sim
