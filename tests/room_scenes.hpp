@@ -1,7 +1,7 @@
 // Small simulated scenes shared by the registration, merge and export tests.
 #pragma once
 
-namespace test {
+namespace mlmap::test {
 
 // An L-shaped pair of rooms with furniture, four poses, strong odometry drift.
 inline const char* const kRoomsJson = R"({
@@ -25,4 +25,4 @@ inline const char* const kRoomsJson = R"({
   ]
 })";
 
-}  // namespace test
+}  // namespace mlmap::test

@@ -1,32 +1,15 @@
 // The mlmap CLI end to end: simulate -> build -> info, and one clear line for bad input.
 #include <doctest/doctest.h>
 
-#include <sys/wait.h>
-
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "cli_runner.hpp"
 #include "helpers.hpp"
 
+using mlmap::test::runCli;
+
 namespace {
-
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-CommandResult runCli(const std::string& arguments) {
-  const std::string command = std::string(MLMAP_CLI_PATH) + " " + arguments + " 2>&1";
-  CommandResult result;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  char buffer[4096];
-  std::size_t count = 0;
-  while ((count = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, count);
-  const int status = ::pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
 
 // A 4 × 3 × 2.5 m box room scanned from two poses with a coarse pattern: seconds, not minutes.
 const char* kBoxRoom = R"({
@@ -47,7 +30,7 @@ std::size_t lineCount(const std::string& text) {
 }  // namespace
 
 TEST_CASE("CLI: --help on every subcommand, and an unknown subcommand fails") {
-  for (const char* command : {"", "simulate ", "build ", "info "}) {
+  for (const char* command : {"", "simulate ", "build ", "info ", "planes ", "label ", "merge ", "export ", "register "}) {
     const auto result = runCli(std::string(command) + "--help");
     CHECK(result.exit_code == 0);
     CHECK(result.output.find("Usage") != std::string::npos);

@@ -18,7 +18,7 @@ using namespace mlmap;
 namespace {
 
 const std::vector<sim::SimulatedScan>& roomScans() {
-  static const std::vector<sim::SimulatedScan> scans = sim::simulate(sim::parseScene(test::kRoomsJson, "rooms.json"));
+  static const std::vector<sim::SimulatedScan> scans = sim::simulate(sim::parseScene(mlmap::test::kRoomsJson, "rooms.json"));
   return scans;
 }
 

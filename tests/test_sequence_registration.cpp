@@ -11,7 +11,7 @@
 using namespace mlmap::registration;
 
 TEST_CASE("SequenceRegistration: scan-to-map and refinement correct drifting odometry") {
-  const mlmap::sim::Scene scene = mlmap::sim::parseScene(test::kRoomsJson, "rooms.json");
+  const mlmap::sim::Scene scene = mlmap::sim::parseScene(mlmap::test::kRoomsJson, "rooms.json");
   const auto scans = mlmap::sim::simulate(scene);
   std::vector<mlmap::Pose> truth;
   std::vector<mlmap::Pose> odometry;

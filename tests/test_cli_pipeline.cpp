@@ -1,0 +1,120 @@
+// The CLI from a labelled map to every export, and merge: with a transform, by
+// registration, and refused when the maps do not overlap.
+#include <doctest/doctest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+#include "helpers.hpp"
+#include "json_schema.hpp"
+#include "mlmap/io/map_file.hpp"
+#include "room_scenes.hpp"
+
+using mlmap::test::runCli;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct RoomMaps {
+  mlmap::test::TempDir dir;
+  fs::path map;       // all scans, true poses
+  fs::path west;      // scans 0 and 1
+  fs::path east;      // scans 2 and 3
+
+  RoomMaps() {
+    mlmap::test::writeText(dir / "rooms.json", mlmap::test::kRoomsJson);
+    auto result = runCli("--quiet simulate " + (dir / "rooms.json").string() + " -o " + (dir / "sim").string());
+    REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+    const auto scan = [&](int k) { return (dir / "sim" / ("scan_00" + std::to_string(k) + ".xyz")).string(); };
+    const std::string poses = (dir / "sim" / "poses_true.txt").string();
+    map = dir / "rooms.mlmap";
+    west = dir / "west.mlmap";
+    east = dir / "east.mlmap";
+    // Each build takes scan k with pose k of its pose file, so each half gets its own.
+    std::ifstream in(poses);
+    std::string line;
+    std::vector<std::string> lines;
+    while (std::getline(in, line)) {
+      if (!line.empty() && line[0] != '#') lines.push_back(line);
+    }
+    REQUIRE(lines.size() == 4);
+    mlmap::test::writeText(dir / "west_poses.txt", lines[0] + "\n" + lines[1] + "\n");
+    mlmap::test::writeText(dir / "east_poses.txt", lines[2] + "\n" + lines[3] + "\n");
+    for (const auto& [output, arguments] :
+         {std::pair{map, "--poses " + poses + " " + scan(0) + " " + scan(1) + " " + scan(2) + " " + scan(3)},
+          std::pair{west, "--poses " + (dir / "west_poses.txt").string() + " " + scan(0) + " " + scan(1)},
+          std::pair{east, "--poses " + (dir / "east_poses.txt").string() + " " + scan(2) + " " + scan(3)}}) {
+      result = runCli("--quiet build --cell-size 0.05 --max-range 12 -o " + output.string() + " " + arguments);
+      REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+    }
+  }
+};
+
+}  // namespace
+
+TEST_CASE("CLI: planes -o keeps the planes in the map, and export writes every format") {
+  RoomMaps rooms;
+  const fs::path labelled = rooms.dir / "labelled.mlmap";
+  auto result = runCli("--quiet planes " + rooms.map.string() + " -o " + labelled.string());
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  REQUIRE(mlmap::io::readMap(labelled).planes().has_value());
+
+  mlmap::test::writeText(rooms.dir / "page.html", "<!doctype html><title>dashboard</title>");
+  const fs::path out = rooms.dir / "out";
+  fs::create_directories(out);
+  result = runCli("--quiet export " + labelled.string() + " --octovis " + (out / "m.ot").string() + " --bt " +
+                  (out / "m.bt").string() + " --ply " + (out / "m.ply").string() + " --json " +
+                  (out / "m.json").string() + " --dashboard " + (out / "web").string() + " --dashboard-page " +
+                  (rooms.dir / "page.html").string());
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  for (const char* name : {"m.ot", "m.bt", "m.ply", "m.json", "web/index.html", "web/planes.json", "web/planes.js"}) {
+    CHECK_MESSAGE(fs::file_size(out / name) > 0, name);
+  }
+  std::ifstream schema_file(mlmap::test::sourceDir() / "web" / "planes.schema.json");
+  const mlmap::test::JsonSchema schema(nlohmann::json::parse(schema_file));
+  const nlohmann::json exported = nlohmann::json::parse(mlmap::test::readText(out / "m.json"));
+  const auto error = schema.check(exported);
+  CHECK_MESSAGE(!error.has_value(), error.value_or(""));
+  CHECK(exported["planes"].size() == mlmap::io::readMap(labelled).planes()->planes.size());
+  CHECK(mlmap::test::readText(out / "web" / "planes.json") == mlmap::test::readText(out / "m.json"));
+  CHECK(mlmap::test::readText(out / "web" / "planes.js").rfind("window.MLMAP_PLANES = {", 0) == 0);
+
+  // Without a page, --dashboard fails at once and writes nothing.
+  result = runCli("--quiet export " + labelled.string() + " --dashboard " + (out / "web2").string() +
+                  " --dashboard-page " + (rooms.dir / "missing.html").string());
+  CHECK(result.exit_code == 1);
+  CHECK(result.output.find("missing.html") != std::string::npos);
+  CHECK_FALSE(fs::exists(out / "web2"));
+  CHECK(runCli("export " + labelled.string()).output.find("nothing to export") != std::string::npos);
+}
+
+TEST_CASE("CLI: merge with a transform, by registration, and refused without overlap") {
+  RoomMaps rooms;
+  const fs::path merged = rooms.dir / "merged.mlmap";
+  auto result = runCli("merge " + rooms.west.string() + " " + rooms.east.string() + " --register -o " +
+                       merged.string());
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  CHECK(result.output.find("blocks:") != std::string::npos);
+  const auto merged_blocks = mlmap::io::readMap(merged).blocks().blockCount();
+  const auto direct_blocks = mlmap::io::readMap(rooms.map).blocks().blockCount();
+  CHECK(static_cast<double>(merged_blocks) < 1.15 * static_cast<double>(direct_blocks));
+
+  // The east map moved 40 m away: ICP from the identity finds nothing to match.
+  mlmap::test::writeText(rooms.dir / "far.txt", "40 0 0 0\n");
+  const fs::path far = rooms.dir / "far.mlmap";
+  result = runCli("--quiet merge " + rooms.west.string() + " " + rooms.east.string() + " --transform " +
+                  (rooms.dir / "far.txt").string() + " -o " + far.string());
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  const fs::path refused = rooms.dir / "refused.mlmap";
+  result = runCli("--quiet merge " + rooms.west.string() + " " + far.string() + " --register -o " + refused.string());
+  CHECK(result.exit_code == 1);
+  CHECK(result.output.find("unreliable") != std::string::npos);
+  CHECK_FALSE(fs::exists(refused));
+
+  mlmap::test::writeText(rooms.dir / "bad.txt", "1 2 three 4\n");
+  result = runCli("--quiet merge " + rooms.west.string() + " " + rooms.east.string() + " --transform " +
+                  (rooms.dir / "bad.txt").string() + " -o " + refused.string());
+  CHECK(result.exit_code == 1);
+  CHECK(result.output.find("bad.txt:1") != std::string::npos);
+}
