@@ -40,7 +40,7 @@ std::filesystem::path findDashboardPage(const std::string& requested) {
       if (std::filesystem::is_regular_file(candidate)) return candidate;
     }
   }
-  throw Error("the web dashboard is not built: run `bash scripts/web-build.sh` (or `npm ci && npm run build` in web/), "
+  throw Error("the web dashboard is not built: run `bash scripts/web-build.sh`, "
               "or pass --dashboard-page web/dist/index.html");
 }
 
