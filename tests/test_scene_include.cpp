@@ -168,6 +168,22 @@ TEST_CASE("Scene include: the output frame is the frame of the scene with the po
   }
 }
 
+TEST_CASE("Scene include: nested placements compose into the provider's frame") {
+  mlmap::test::TempDir dir;
+  mlmap::test::writeText(dir / "part.json", kPartJson);
+  mlmap::test::writeText(dir / "mid.json", R"({"include": [{"scene": "part.json", "y": 2, "yaw_deg": 90, "poses": true}]})");
+  mlmap::test::writeText(dir / "top.json", R"({"include": [{"scene": "mid.json", "x": 1, "poses": true}],
+    "surfaces": [{"type": "rectangle", "name": "far", "class": "wall", "min": [5, -3, 0], "max": [5, 3, 3]}]})");
+  const Scene scene = loadScene(dir / "top.json");
+  CHECK(scene.poses[0].x == 0.5);  // part's own
+  // part's frame lies at (1, 2, 90°) in top's: top's wall x = 5 is part's y = -4.
+  const auto far = planeNamed(scene, "far");
+  REQUIRE(far);
+  CHECK(far->normal == -Eigen::Vector3d::UnitY());
+  CHECK(far->d == -4.0);
+  CHECK(planeNamed(scene, "mid/part/wall"));
+}
+
 TEST_CASE("Scene include: cycles, depth and bad paths are refused with the file named") {
   mlmap::test::TempDir dir;
   mlmap::test::writeText(dir / "a.json", "{" + kOwnPoses + R"(, "include": [{"scene": "b.json"}]})");
