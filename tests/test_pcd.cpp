@@ -444,6 +444,24 @@ TEST_CASE("pcd: bad binary bodies fail naming file and byte") {
   CHECK_MESSAGE(contains(message, "bad.pcd: byte " + std::to_string(too_short.size())), message);
 }
 
+TEST_CASE("pcd: an LZF block that expands past its declared size is refused") {
+  TempDir dir;
+  const auto path = dir / "long.pcd";
+  // One point (12 bytes) declared, sizes consistent, but the block expands to 24 bytes:
+  // the decompressor stops at the declared size instead of writing past it.
+  std::string unpacked;
+  for (int i = 0; i < 6; ++i) put<float>(unpacked, static_cast<float>(i));
+  const std::string packed = lzfLiterals(unpacked);
+  std::string bytes = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nDATA binary_compressed\n";
+  const std::size_t body_start = bytes.size();
+  put<std::uint32_t>(bytes, static_cast<std::uint32_t>(packed.size()));
+  put<std::uint32_t>(bytes, 12);
+  writeText(path, bytes + packed);
+  const std::string message = errorOf([&] { readPcd(path); });
+  CHECK_MESSAGE(contains(message, "long.pcd: byte " + std::to_string(body_start + 8)), message);
+  CHECK_MESSAGE(contains(message, "declared 12 bytes"), message);
+}
+
 TEST_CASE("pcd: random corruption of binary and compressed files never crashes") {
   TempDir dir;
   const Scan scan = randomScan(200, true, false, 3);

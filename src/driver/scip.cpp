@@ -374,6 +374,11 @@ ScipScan ScipClient::nextScan(int max_drops) {
       last = error;
     }
   }
+  if (!last) {  // nothing but acknowledgements
+    throw ScipError(ScipError::Kind::Malformed,
+                    reader_.transport().name() + ": " + stream_echo_ + ": " +
+                        std::to_string(max_drops + 1) + " frames in a row without scan data");
+  }
   throw *last;
 }
 
