@@ -7,7 +7,9 @@
 
 namespace mlmap {
 
-BlockGrid::BlockGrid(const MLMap& map) : cell_size_(map.cellSize()) {
+BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_size_(map.cellSize()) {
+  const auto stack_gap = static_cast<float>(config.stack_gap);
+  const auto level_band = static_cast<float>(std::max(config.level_band, cell_size_));
   const std::size_t cell_count = map.cellCount();
   blocks_.reserve(map.blockCount());
   cell_first_.reserve(cell_count + 1);
@@ -19,19 +21,43 @@ BlockGrid::BlockGrid(const MLMap& map) : cell_size_(map.cellSize()) {
     cell_first_.push_back(static_cast<std::uint32_t>(blocks_.size()));
     const CellIndex cell = map.cellAt(n);
     const Eigen::Vector2d centre = map.cellCenter(cell);
-    for (const Block& block : map.blocksAt(n)) {
+    const std::span<const Block> cell_blocks = map.blocksAt(n);
+    for (std::size_t first = 0; first < cell_blocks.size();) {
+      // The stack: this block and the ones above it closer than the stack gap.
+      std::size_t last = first;
+      float top = cell_blocks[first].height;
+      while (last + 1 < cell_blocks.size() && cell_blocks[last + 1].bottom() - top < stack_gap) {
+        ++last;
+        top = std::max(top, cell_blocks[last].height);
+      }
       PlaneBlock view;
-      view.top = block.height;
-      view.bottom = block.bottom();
-      // A vertical block shallower than a cell is the edge of a horizontal surface
-      // (a table top with its rim, a stair tread with the top of its riser) far more
-      // often than a wall: eRMSM treats it as horizontal, at its top.
-      view.vertical = block.isVertical() && block.depth >= cell_size_;
-      view.surface = view.vertical ? static_cast<float>(block.depth / cell_size_) : 1.0F;
+      view.top = top;
+      view.bottom = cell_blocks[first].bottom();
+      view.map_first = static_cast<std::uint16_t>(first);
+      view.map_count = static_cast<std::uint16_t>(last - first + 1);
+      // A stack shallower than the level band is the edge of a horizontal surface (a
+      // table top with its rim, a stair tread with the top of its riser) or a level
+      // surface split by range noise far more often than a wall: eRMSM treats it as
+      // horizontal, at its top when it is one vertical block, else at the members'
+      // inverse-variance mean height.
+      view.vertical = view.top - view.bottom >= level_band;
+      view.surface = view.vertical ? static_cast<float>((view.top - view.bottom) / cell_size_) : 1.0F;
+      float level = view.top;
+      if (!view.vertical && last > first) {
+        double weighted = 0.0;
+        double weight = 0.0;
+        for (std::size_t k = first; k <= last; ++k) {
+          const double w = 1.0 / std::max(cell_blocks[k].variance, 1e-12F);
+          weighted += w * cell_blocks[k].height;
+          weight += w;
+        }
+        level = static_cast<float>(weighted / weight);
+      }
       view.point = Eigen::Vector3f(static_cast<float>(centre.x()), static_cast<float>(centre.y()),
-                                   view.vertical ? 0.5F * (view.top + view.bottom) : view.top);
+                                   view.vertical ? 0.5F * (view.top + view.bottom) : level);
       view.cell = cell;
       blocks_.push_back(view);
+      first = last + 1;
     }
     min_i_ = std::min<std::int64_t>(min_i_, cell.i);
     min_j_ = std::min<std::int64_t>(min_j_, cell.j);

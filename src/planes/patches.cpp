@@ -1,26 +1,13 @@
 #include "mlmap/planes/patches.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numeric>
-#include <unordered_map>
 
 namespace mlmap {
 namespace {
-
-struct GridCell {
-  std::int32_t u = 0;
-  std::int32_t v = 0;
-  friend bool operator==(const GridCell&, const GridCell&) = default;
-};
-
-struct GridCellHash {
-  std::size_t operator()(const GridCell& cell) const {
-    return (static_cast<std::size_t>(static_cast<std::uint32_t>(cell.u)) * 0x9E3779B97F4A7C15ULL) ^
-           static_cast<std::uint32_t>(cell.v);
-  }
-};
 
 class DisjointSets {
  public:
@@ -41,45 +28,124 @@ class DisjointSets {
   std::vector<std::size_t> parent_;
 };
 
-}  // namespace
+// Blocks rasterised on a grid of cell_size in the plane: a dense raster over their
+// bounding box with a margin (planes in a building are compact, and lookups in an
+// array beat a hash map by far). Raster cell (u, v) covers [u, u + 1) × [v, v + 1) cells
+// along the plane basis from `point`.
+struct PlaneRaster {
+  std::int32_t min_u = 0;
+  std::int32_t min_v = 0;
+  std::int64_t columns = 0;
+  std::int64_t rows = 0;
+  int margin = 0;
+  std::vector<std::int32_t> slots;         // per raster cell: its number among the occupied ones, −1 empty
+  std::vector<Eigen::Vector2i> cells;      // occupied cells, in order of first use
+  std::vector<std::size_t> first_of_block; // a block's cells in block_cells: [first_of_block[k], first_of_block[k + 1])
+  std::vector<std::size_t> block_cells;    // occupied-cell numbers
 
-void planeBasis(const Eigen::Vector3d& normal, Eigen::Vector3d& u, Eigen::Vector3d& v) {
-  u = Eigen::Vector3d::UnitZ().cross(normal);
-  if (u.norm() < 0.3) u = normal.cross(Eigen::Vector3d::UnitX()).cross(normal);
-  u.normalize();
-  v = normal.cross(u).normalized();
-}
-
-namespace {
-
-// The outer boundary of a set of grid cells: the sides of occupied cells facing
-// empty ones, chained into loops; the loop enclosing the most area is the outline.
-std::vector<Eigen::Vector2i> outerBoundary(const std::vector<GridCell>& cells) {
-  std::unordered_map<GridCell, bool, GridCellHash> occupied;
-  for (const GridCell& cell : cells) occupied[cell] = true;
-  auto isOccupied = [&](std::int32_t u, std::int32_t v) { return occupied.count(GridCell{u, v}) > 0; };
-  // Directed edges with the cells on their left: counter-clockwise loops.
-  std::multimap<std::pair<int, int>, std::pair<int, int>> next;
-  for (const GridCell& c : cells) {
-    if (!isOccupied(c.u, c.v - 1)) next.emplace(std::pair{c.u, c.v}, std::pair{c.u + 1, c.v});
-    if (!isOccupied(c.u + 1, c.v)) next.emplace(std::pair{c.u + 1, c.v}, std::pair{c.u + 1, c.v + 1});
-    if (!isOccupied(c.u, c.v + 1)) next.emplace(std::pair{c.u + 1, c.v + 1}, std::pair{c.u, c.v + 1});
-    if (!isOccupied(c.u - 1, c.v)) next.emplace(std::pair{c.u, c.v + 1}, std::pair{c.u, c.v});
+  std::int32_t& at(std::int64_t u, std::int64_t v) {
+    return slots[static_cast<std::size_t>((v - min_v + margin) * columns + (u - min_u + margin))];
   }
+
+  PlaneRaster(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& u_axis,
+              const Eigen::Vector3d& v_axis, const Eigen::Vector3d& point, int margin_cells)
+      : margin(margin_cells) {
+    const double cell = grid.cellSize();
+    std::vector<Eigen::Vector2i> raw;
+    first_of_block.resize(blocks.size() + 1);
+    auto cellOf = [&](const Eigen::Vector3d& p) {
+      const Eigen::Vector3d relative = p - point;
+      return Eigen::Vector2i(static_cast<std::int32_t>(std::floor(relative.dot(u_axis) / cell)),
+                             static_cast<std::int32_t>(std::floor(relative.dot(v_axis) / cell)));
+    };
+    for (std::size_t k = 0; k < blocks.size(); ++k) {
+      first_of_block[k] = raw.size();
+      const PlaneBlock& block = grid.blocks()[blocks[k]];
+      const Eigen::Vector3d centre = block.point.cast<double>();
+      raw.push_back(cellOf(centre));
+      if (!block.vertical) continue;
+      const double depth = block.top - block.bottom;
+      const int steps = std::max(1, static_cast<int>(std::ceil(depth / cell)));
+      for (int s = 0; s <= steps; ++s) {
+        raw.push_back(cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.bottom + depth * s / steps)));
+      }
+    }
+    first_of_block[blocks.size()] = raw.size();
+    if (raw.empty()) return;
+    min_u = raw[0].x();
+    min_v = raw[0].y();
+    std::int32_t max_u = min_u;
+    std::int32_t max_v = min_v;
+    for (const Eigen::Vector2i& c : raw) {
+      min_u = std::min(min_u, c.x());
+      max_u = std::max(max_u, c.x());
+      min_v = std::min(min_v, c.y());
+      max_v = std::max(max_v, c.y());
+    }
+    columns = static_cast<std::int64_t>(max_u) - min_u + 1 + 2 * margin;
+    rows = static_cast<std::int64_t>(max_v) - min_v + 1 + 2 * margin;
+    slots.assign(static_cast<std::size_t>(columns * rows), -1);
+    block_cells.resize(raw.size());
+    for (std::size_t n = 0; n < raw.size(); ++n) {
+      std::int32_t& slot = at(raw[n].x(), raw[n].y());
+      if (slot < 0) {
+        slot = static_cast<std::int32_t>(cells.size());
+        cells.push_back(raw[n]);
+      }
+      block_cells[n] = static_cast<std::size_t>(slot);
+    }
+  }
+};
+
+// The outer boundary of the occupied cells accepted by `inside`: the sides of those
+// cells facing other cells, chained into counter-clockwise loops; the loop enclosing
+// the most area, corners only.
+template <typename Inside>
+std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside) {
+  // Vertices of the raster with a margin of one: each has at most two outgoing edges.
+  const std::int64_t vertex_columns = raster.columns + 1;
+  auto vertexOf = [&](std::int64_t u, std::int64_t v) {
+    return static_cast<std::size_t>((v - raster.min_v + raster.margin) * vertex_columns + (u - raster.min_u + raster.margin));
+  };
+  std::vector<std::array<std::int32_t, 2>> out(static_cast<std::size_t>(vertex_columns * (raster.rows + 1)), {-1, -1});
+  std::vector<Eigen::Vector2i> edge_from;
+  std::vector<Eigen::Vector2i> edge_to;
+  auto occupied = [&](std::int64_t u, std::int64_t v) {
+    if (u < raster.min_u - raster.margin || v < raster.min_v - raster.margin ||
+        u >= raster.min_u - raster.margin + raster.columns || v >= raster.min_v - raster.margin + raster.rows) {
+      return false;
+    }
+    const std::int32_t slot = raster.at(u, v);
+    return slot >= 0 && inside(static_cast<std::size_t>(slot));
+  };
+  auto addEdge = [&](const Eigen::Vector2i& from, const Eigen::Vector2i& to) {
+    auto& slots = out[vertexOf(from.x(), from.y())];
+    (slots[0] < 0 ? slots[0] : slots[1]) = static_cast<std::int32_t>(edge_from.size());
+    edge_from.push_back(from);
+    edge_to.push_back(to);
+  };
+  for (std::size_t n = 0; n < raster.cells.size(); ++n) {
+    if (!inside(n)) continue;
+    const int u = raster.cells[n].x();
+    const int v = raster.cells[n].y();
+    if (!occupied(u, v - 1)) addEdge({u, v}, {u + 1, v});
+    if (!occupied(u + 1, v)) addEdge({u + 1, v}, {u + 1, v + 1});
+    if (!occupied(u, v + 1)) addEdge({u + 1, v + 1}, {u, v + 1});
+    if (!occupied(u - 1, v)) addEdge({u, v + 1}, {u, v});
+  }
+  std::vector<std::uint8_t> used(edge_from.size(), 0);
   std::vector<Eigen::Vector2i> best;
   long best_area = 0;
-  while (!next.empty()) {
+  for (std::size_t start = 0; start < edge_from.size(); ++start) {
+    if (used[start] != 0) continue;
     std::vector<Eigen::Vector2i> loop;
-    auto edge = next.begin();
-    const std::pair<int, int> start = edge->first;
-    std::pair<int, int> at = start;
-    while (true) {
-      auto found = next.find(at);
-      if (found == next.end()) break;
-      loop.emplace_back(at.first, at.second);
-      at = found->second;
-      next.erase(found);
-      if (at == start) break;
+    std::int32_t edge = static_cast<std::int32_t>(start);
+    while (edge >= 0 && used[static_cast<std::size_t>(edge)] == 0) {
+      used[static_cast<std::size_t>(edge)] = 1;
+      loop.push_back(edge_from[static_cast<std::size_t>(edge)]);
+      const Eigen::Vector2i& to = edge_to[static_cast<std::size_t>(edge)];
+      const auto& next = out[vertexOf(to.x(), to.y())];
+      edge = next[0] >= 0 && used[static_cast<std::size_t>(next[0])] == 0 ? next[0] : next[1];
     }
     long twice_area = 0;
     for (std::size_t k = 0; k < loop.size(); ++k) {
@@ -92,7 +158,6 @@ std::vector<Eigen::Vector2i> outerBoundary(const std::vector<GridCell>& cells) {
       best = std::move(loop);
     }
   }
-  // Keep corners only.
   std::vector<Eigen::Vector2i> corners;
   for (std::size_t k = 0; k < best.size(); ++k) {
     const Eigen::Vector2i& previous = best[(k + best.size() - 1) % best.size()];
@@ -106,6 +171,13 @@ std::vector<Eigen::Vector2i> outerBoundary(const std::vector<GridCell>& cells) {
 
 }  // namespace
 
+void planeBasis(const Eigen::Vector3d& normal, Eigen::Vector3d& u, Eigen::Vector3d& v) {
+  u = Eigen::Vector3d::UnitZ().cross(normal);
+  if (u.norm() < 0.3) u = normal.cross(Eigen::Vector3d::UnitX()).cross(normal);
+  u.normalize();
+  v = normal.cross(u).normalized();
+}
+
 std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
                                     const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
                                     int gap_cells) {
@@ -113,60 +185,14 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;
   planeBasis(normal, u_axis, v_axis);
-  const double cell = grid.cellSize();
-  // Every block's grid cells on the plane (a vertical block covers its height).
-  std::vector<GridCell> block_cells;
-  std::vector<std::size_t> first_cell_of_block(blocks.size() + 1);
-  auto cellOf = [&](const Eigen::Vector3d& p) {
-    const Eigen::Vector3d relative = p - point;
-    return GridCell{static_cast<std::int32_t>(std::floor(relative.dot(u_axis) / cell)),
-                    static_cast<std::int32_t>(std::floor(relative.dot(v_axis) / cell))};
-  };
-  for (std::size_t k = 0; k < blocks.size(); ++k) {
-    first_cell_of_block[k] = block_cells.size();
-    const PlaneBlock& block = grid.blocks()[blocks[k]];
-    const Eigen::Vector3d centre = block.point.cast<double>();
-    block_cells.push_back(cellOf(centre));
-    if (!block.vertical) continue;
-    const double depth = block.top - block.bottom;
-    const int steps = std::max(1, static_cast<int>(std::ceil(depth / cell)));
-    for (int s = 0; s <= steps; ++s) {
-      block_cells.push_back(cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.bottom + depth * s / steps)));
-    }
-  }
-  first_cell_of_block[blocks.size()] = block_cells.size();
-  // A dense raster over the cells' bounding box (with a margin for the gap): planes
-  // in a building are compact, and lookups in an array beat a hash map by far.
-  std::int32_t min_u = block_cells[0].u, max_u = min_u, min_v = block_cells[0].v, max_v = min_v;
-  for (const GridCell& c : block_cells) {
-    min_u = std::min(min_u, c.u);
-    max_u = std::max(max_u, c.u);
-    min_v = std::min(min_v, c.v);
-    max_v = std::max(max_v, c.v);
-  }
-  const std::int64_t columns = static_cast<std::int64_t>(max_u) - min_u + 1 + 2 * gap_cells;
-  const std::int64_t rows = static_cast<std::int64_t>(max_v) - min_v + 1 + 2 * gap_cells;
-  std::vector<std::int32_t> raster(static_cast<std::size_t>(columns * rows), -1);
-  auto at = [&](std::int64_t u, std::int64_t v) -> std::int32_t& {
-    return raster[static_cast<std::size_t>((v - min_v + gap_cells) * columns + (u - min_u + gap_cells))];
-  };
-  std::vector<GridCell> cells;  // distinct occupied cells
-  std::vector<std::size_t> cell_of(block_cells.size());
-  for (std::size_t n = 0; n < block_cells.size(); ++n) {
-    std::int32_t& slot = at(block_cells[n].u, block_cells[n].v);
-    if (slot < 0) {
-      slot = static_cast<std::int32_t>(cells.size());
-      cells.push_back(block_cells[n]);
-    }
-    cell_of[n] = static_cast<std::size_t>(slot);
-  }
-  DisjointSets sets(cells.size());
-  for (std::size_t n = 0; n < cells.size(); ++n) {
+  PlaneRaster raster(grid, blocks, u_axis, v_axis, point, gap_cells);
+  DisjointSets sets(raster.cells.size());
+  for (std::size_t n = 0; n < raster.cells.size(); ++n) {
     // Half the neighbourhood suffices: the other half links back to this cell.
     for (int dv = 0; dv <= gap_cells; ++dv) {
       for (int du = -gap_cells; du <= gap_cells; ++du) {
         if (dv == 0 && du <= 0) continue;
-        const std::int32_t other = at(cells[n].u + du, cells[n].v + dv);
+        const std::int32_t other = raster.at(raster.cells[n].x() + du, raster.cells[n].y() + dv);
         if (other >= 0) sets.unite(n, static_cast<std::size_t>(other));
       }
     }
@@ -174,23 +200,31 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
   // Components keyed by their root; roots are the smallest cell number, so the
   // order is deterministic.
   std::map<std::size_t, Patch> by_root;
-  std::map<std::size_t, std::vector<GridCell>> cells_by_root;
-  for (std::size_t n = 0; n < cells.size(); ++n) cells_by_root[sets.find(n)].push_back(cells[n]);
   for (std::size_t k = 0; k < blocks.size(); ++k) {
-    Patch& patch = by_root[sets.find(cell_of[first_cell_of_block[k]])];
+    Patch& patch = by_root[sets.find(raster.block_cells[raster.first_of_block[k]])];
     patch.blocks.push_back(blocks[k]);
     patch.surface += grid.blocks()[blocks[k]].surface;
   }
   std::vector<Patch> patches;
-  for (auto& [root, patch] : by_root) {
-    for (const Eigen::Vector2i& corner : outerBoundary(cells_by_root[root])) {
-      patch.outline.push_back(point + u_axis * (corner.x() * cell) + v_axis * (corner.y() * cell));
-    }
-    patches.push_back(std::move(patch));
-  }
+  for (auto& [root, patch] : by_root) patches.push_back(std::move(patch));
   std::stable_sort(patches.begin(), patches.end(),
                    [](const Patch& a, const Patch& b) { return a.surface > b.surface; });
   return patches;
+}
+
+std::vector<Eigen::Vector3d> outlineOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
+                                       const Eigen::Vector3d& normal, const Eigen::Vector3d& point) {
+  std::vector<Eigen::Vector3d> outline;
+  if (blocks.empty()) return outline;
+  Eigen::Vector3d u_axis;
+  Eigen::Vector3d v_axis;
+  planeBasis(normal, u_axis, v_axis);
+  PlaneRaster raster(grid, blocks, u_axis, v_axis, point, 1);
+  const double cell = grid.cellSize();
+  for (const Eigen::Vector2i& corner : outerBoundary(raster, [](std::size_t) { return true; })) {
+    outline.push_back(point + u_axis * (corner.x() * cell) + v_axis * (corner.y() * cell));
+  }
+  return outline;
 }
 
 }  // namespace mlmap

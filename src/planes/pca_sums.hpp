@@ -27,6 +27,13 @@ struct PcaSums {
     sum += w * p;
     outer += w * p * p.transpose();
   }
+  // Adds sums taken relative to another reference: `shift` = that reference minus this one.
+  void addShifted(const PcaSums& other, const Eigen::Vector3d& shift) {
+    weight += other.weight;
+    sum += other.sum + other.weight * shift;
+    outer += other.outer + other.sum * shift.transpose() + shift * other.sum.transpose() +
+             other.weight * shift * shift.transpose();
+  }
   Eigen::Vector3d mean() const { return sum / weight; }
   Eigen::Matrix3d covariance() const {
     const Eigen::Vector3d m = mean();

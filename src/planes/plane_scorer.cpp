@@ -1,16 +1,37 @@
 #include "plane_scorer.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numbers>
+#include <tuple>
 
 namespace mlmap {
 namespace {
 
-constexpr int kElevationRows = 9;     // 10° each over [0°, 90°]
-constexpr int kAzimuthColumns = 36;   // 10° each over the full circle
-constexpr double kBinRadius = 7.1 * std::numbers::pi / 180.0;  // half the diagonal of a 10° bin
+constexpr int kElevationRows = 9;  // 10° each over [0°, 90°]; the top row is one polar cap
+// A tile is this many cells wide: large enough that a plane's slab holds whole tiles,
+// small enough that the slab's faces cut few blocks.
+constexpr int kTileCells = 16;
+// Cones closer than this to κ are decided block by block (float rounding).
+constexpr float kCosMargin = 1e-5F;
+
+// Azimuth columns per elevation row, so that bins cover similar solid angles.
+int columnsOf(int row) {
+  if (row == kElevationRows - 1) return 1;
+  const double elevation = (row + 0.5) * (std::numbers::pi / 2) / kElevationRows;
+  return std::max(1, static_cast<int>(std::lround(36.0 * std::cos(elevation))));
+}
+
+int firstBinOf(int row) {
+  int first = 0;
+  for (int r = 0; r < row; ++r) first += columnsOf(r);
+  return first;
+}
+
+int binCount() { return firstBinOf(kElevationRows); }
 
 int binOf(const Eigen::Vector3f& direction) {
   // Unsigned axes: use the upper hemisphere's representative.
@@ -19,11 +40,39 @@ int binOf(const Eigen::Vector3f& direction) {
   double azimuth = std::atan2(axis.y(), axis.x());
   if (azimuth < 0.0) azimuth += 2.0 * std::numbers::pi;
   const int row = std::min(kElevationRows - 1, static_cast<int>(elevation / (std::numbers::pi / 2) * kElevationRows));
-  const int column = std::min(kAzimuthColumns - 1, static_cast<int>(azimuth / (2 * std::numbers::pi) * kAzimuthColumns));
-  return row * kAzimuthColumns + column;
+  const int columns = columnsOf(row);
+  const int column = std::min(columns - 1, static_cast<int>(azimuth / (2 * std::numbers::pi) * columns));
+  return firstBinOf(row) + column;
 }
 
 }  // namespace
+
+// The plane against a node: the cone of its directions against κ, its box against the slab.
+struct PlaneScorer::Query {
+  Eigen::Vector3f normal;
+  float offset;
+  float cos_kappa;
+  float epsilon;
+
+  template <typename NodeT>
+  Cone cone(const NodeT& node) const {
+    const float cos_t = std::min(1.0F, std::abs(node.axis.dot(normal)));
+    const float sin_t = std::sqrt(std::max(0.0F, 1.0F - cos_t * cos_t));
+    const float cos_r = node.cos_radius;
+    const float sin_r = std::sqrt(std::max(0.0F, 1.0F - cos_r * cos_r));
+    if (cos_t * cos_r - sin_t * sin_r > cos_kappa + kCosMargin) return Cone::Inside;  // t + ρ < κ
+    if (cos_t < cos_r && cos_t * cos_r + sin_t * sin_r < cos_kappa - kCosMargin) return Cone::Outside;  // t − ρ > κ
+    return Cone::Cut;
+  }
+  template <typename NodeT>
+  Slab slab(const NodeT& node, const Eigen::Vector3f& frame_normal) const {
+    const float distance = std::abs(normal.dot(node.centre) + offset);
+    const float radius = frame_normal.dot(node.half_extent);
+    if (distance - radius >= epsilon) return Slab::Outside;
+    if (distance + radius < epsilon) return Slab::Inside;
+    return Slab::Cut;
+  }
+};
 
 PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                          double epsilon, double kappa_rad)
@@ -31,58 +80,234 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
       directions_(directions),
       epsilon_(static_cast<float>(epsilon)),
       cos_kappa_(static_cast<float>(std::cos(kappa_rad))),
-      cos_bin_reach_(static_cast<float>(std::cos(std::min(kappa_rad + kBinRadius, std::numbers::pi / 2)))),
-      bins_(kElevationRows * kAzimuthColumns),
-      taken_(grid.size(), 0) {
-  for (int row = 0; row < kElevationRows; ++row) {
-    for (int column = 0; column < kAzimuthColumns; ++column) {
-      const double elevation = (row + 0.5) * (std::numbers::pi / 2) / kElevationRows;
-      const double azimuth = (column + 0.5) * 2 * std::numbers::pi / kAzimuthColumns;
-      bins_[static_cast<std::size_t>(row * kAzimuthColumns + column)].axis =
-          Eigen::Vector3f(static_cast<float>(std::cos(elevation) * std::cos(azimuth)),
-                          static_cast<float>(std::cos(elevation) * std::sin(azimuth)),
-                          static_cast<float>(std::sin(elevation)));
+      taken_(grid.size(), 0),
+      position_(grid.size(), UINT32_MAX) {
+  const auto bins = static_cast<std::size_t>(binCount());
+  // Each bin's axis: the mean of its members' directions (so a bin of wall blocks,
+  // whose directions are level, has a level axis), and a frame across it.
+  std::vector<std::int32_t> bin_of(grid.size(), -1);
+  std::vector<Eigen::Vector3f> sums(bins, Eigen::Vector3f::Zero());
+  std::vector<Eigen::Vector3f> first(bins, Eigen::Vector3f::Zero());
+  for (std::uint32_t id = 0; id < grid.size(); ++id) {
+    const Eigen::Vector3f& d = directions[id];
+    if (d.squaredNorm() == 0.0F) continue;
+    const int bin = binOf(d);
+    bin_of[id] = bin;
+    Eigen::Vector3f& reference = first[static_cast<std::size_t>(bin)];
+    if (reference.squaredNorm() == 0.0F) reference = d;
+    sums[static_cast<std::size_t>(bin)] += d.dot(reference) < 0.0F ? Eigen::Vector3f(-d) : d;
+  }
+  frames_.resize(bins);
+  for (std::size_t b = 0; b < bins; ++b) {
+    Frame& frame = frames_[b];
+    frame.a = sums[b].squaredNorm() > 0.0F ? sums[b].normalized() : Eigen::Vector3f::UnitZ();
+    const Eigen::Vector3f helper = std::abs(frame.a.z()) < 0.9F ? Eigen::Vector3f::UnitZ() : Eigen::Vector3f::UnitX();
+    frame.u = frame.a.cross(helper).normalized();
+    frame.v = frame.a.cross(frame.u);
+  }
+  const double layer_size = 0.5 * epsilon;
+  const double tile_size = kTileCells * grid.cellSize();
+  using Key = std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int32_t, std::uint32_t>;
+  std::vector<Key> keys;
+  for (std::uint32_t id = 0; id < grid.size(); ++id) {
+    if (bin_of[id] < 0) continue;
+    const Frame& frame = frames_[static_cast<std::size_t>(bin_of[id])];
+    const Eigen::Vector3f& p = grid.blocks()[id].point;
+    keys.emplace_back(bin_of[id], static_cast<std::int32_t>(std::floor(frame.a.dot(p) / layer_size)),
+                      static_cast<std::int32_t>(std::floor(frame.u.dot(p) / tile_size)),
+                      static_cast<std::int32_t>(std::floor(frame.v.dot(p) / tile_size)), id);
+  }
+  std::sort(keys.begin(), keys.end());
+  bins_.resize(bins);
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    const auto [bin, layer, tu, tv, id] = keys[k];
+    const bool new_bin = k == 0 || std::get<0>(keys[k - 1]) != bin;
+    const bool new_layer = new_bin || std::get<1>(keys[k - 1]) != layer;
+    const bool new_tile = new_layer || std::get<2>(keys[k - 1]) != tu || std::get<3>(keys[k - 1]) != tv;
+    if (new_bin) bins_[static_cast<std::size_t>(bin)].begin = static_cast<std::uint32_t>(layers_.size());
+    if (new_layer) {
+      layers_.emplace_back();
+      layers_.back().begin = static_cast<std::uint32_t>(tiles_.size());
+      bin_of_layer_.push_back(static_cast<std::uint32_t>(bin));
+    }
+    if (new_tile) {
+      tiles_.emplace_back();
+      tiles_.back().begin = static_cast<std::uint32_t>(ids_.size());
+      layer_of_tile_.push_back(static_cast<std::uint32_t>(layers_.size() - 1));
+    }
+    bins_[static_cast<std::size_t>(bin)].end = static_cast<std::uint32_t>(layers_.size());
+    layers_.back().end = static_cast<std::uint32_t>(tiles_.size());
+    position_[id] = static_cast<std::uint32_t>(ids_.size());
+    tile_of_.push_back(static_cast<std::uint32_t>(tiles_.size() - 1));
+    const PlaneBlock& block = grid.blocks()[id];
+    ids_.push_back(id);
+    points_.push_back(block.point);
+    block_directions_.push_back(directions[id]);
+    surfaces_.push_back(block.surface);
+    half_depths_.push_back(block.vertical ? 0.5F * (block.top - block.bottom) : 0.0F);
+    order_taken_.push_back(0);
+    tiles_.back().end = static_cast<std::uint32_t>(ids_.size());
+  }
+  // Every node's cone and box, from its blocks.
+  auto describe = [&](Node& node, const Frame& frame, std::uint32_t begin, std::uint32_t end) {
+    Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+    Eigen::Vector3f low = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+    Eigen::Vector3f high = -low;
+    for (std::uint32_t k = begin; k < end; ++k) {
+      const Eigen::Vector3f& d = block_directions_[k];
+      mean += d.dot(frame.a) < 0.0F ? Eigen::Vector3f(-d) : d;
+      const Eigen::Vector3f q(frame.a.dot(points_[k]), frame.u.dot(points_[k]), frame.v.dot(points_[k]));
+      low = low.cwiseMin(q);
+      high = high.cwiseMax(q);
+    }
+    node.axis = mean.normalized();
+    node.cos_radius = 1.0F;
+    for (std::uint32_t k = begin; k < end; ++k) {
+      node.cos_radius = std::min(node.cos_radius, std::abs(node.axis.dot(block_directions_[k])));
+    }
+    const Eigen::Vector3f centre = 0.5F * (low + high);
+    node.centre = frame.a * centre.x() + frame.u * centre.y() + frame.v * centre.z();
+    // A little slack for the float rounding of the frame change.
+    node.half_extent = 0.5F * (high - low) + Eigen::Vector3f::Constant(1e-5F);
+  };
+  for (std::size_t b = 0; b < bins; ++b) {
+    Node& bin = bins_[b];
+    if (bin.begin == bin.end) continue;
+    const std::uint32_t block_begin = tiles_[layers_[bin.begin].begin].begin;
+    const std::uint32_t block_end = tiles_[layers_[bin.end - 1].end - 1].end;
+    describe(bin, frames_[b], block_begin, block_end);
+    for (std::uint32_t l = bin.begin; l < bin.end; ++l) {
+      Node& layer = layers_[l];
+      describe(layer, frames_[b], tiles_[layer.begin].begin, tiles_[layer.end - 1].end);
+      for (std::uint32_t t = layer.begin; t < layer.end; ++t) describe(tiles_[t], frames_[b], tiles_[t].begin, tiles_[t].end);
     }
   }
-  slot_.assign(grid.size(), {UINT32_MAX, 0});
-  for (std::uint32_t id = 0; id < grid.size(); ++id) {
-    if (directions[id].squaredNorm() == 0.0F) continue;
-    const auto bin_number = static_cast<std::uint32_t>(binOf(directions[id]));
-    Bin& bin = bins_[bin_number];
-    const PlaneBlock& block = grid.blocks()[id];
-    slot_[id] = {bin_number, static_cast<std::uint32_t>(bin.ids.size())};
-    bin.ids.push_back(id);
-    bin.points.push_back(block.point);
-    bin.directions.push_back(directions[id]);
-    bin.surfaces.push_back(block.surface);
-    bin.half_depths.push_back(block.vertical ? 0.5F * (block.top - block.bottom) : 0.0F);
-    bin.taken.push_back(0);
-  }
+  std::vector<std::uint32_t> all_tiles(tiles_.size());
+  for (std::uint32_t t = 0; t < tiles_.size(); ++t) all_tiles[t] = t;
+  refresh(all_tiles);
 }
 
-template <typename Visit>
-void PlaneScorer::forEachSimilar(const CandidatePlane& plane, Visit&& visit) const {
-  for (const Bin& bin : bins_) {
-    if (bin.ids.empty() || std::abs(bin.axis.dot(plane.normal)) < cos_bin_reach_) continue;
-    const std::size_t count = bin.ids.size();
-    for (std::size_t k = 0; k < count; ++k) {
-      if (bin.taken[k] != 0) continue;
-      if (std::abs(bin.directions[k].dot(plane.normal)) < cos_kappa_) continue;
-      visit(bin, k);
+// Recomputes the sums of the given tiles (ascending) and of their layers and bins.
+void PlaneScorer::refresh(const std::vector<std::uint32_t>& tiles) {
+  std::vector<std::uint32_t> layers;
+  for (const std::uint32_t t : tiles) {
+    Node& tile = tiles_[t];
+    tile.untaken = 0;
+    tile.surface = 0.0;
+    tile.pca = PcaSums{};
+    for (std::uint32_t k = tile.begin; k < tile.end; ++k) {
+      if (order_taken_[k] != 0) continue;
+      ++tile.untaken;
+      tile.surface += surfaces_[k];
+      tile.pca.addBlock((points_[k] - tile.centre).cast<double>(), half_depths_[k], surfaces_[k]);
+    }
+    if (layers.empty() || layers.back() != layer_of_tile_[t]) layers.push_back(layer_of_tile_[t]);
+  }
+  std::vector<std::uint32_t> bins;
+  for (const std::uint32_t l : layers) {
+    Node& layer = layers_[l];
+    layer.untaken = 0;
+    layer.surface = 0.0;
+    layer.pca = PcaSums{};
+    for (std::uint32_t t = layer.begin; t < layer.end; ++t) {
+      layer.untaken += tiles_[t].untaken;
+      layer.surface += tiles_[t].surface;
+      layer.pca.addShifted(tiles_[t].pca, (tiles_[t].centre - layer.centre).cast<double>());
+    }
+    if (bins.empty() || bins.back() != bin_of_layer_[l]) bins.push_back(bin_of_layer_[l]);
+  }
+  for (const std::uint32_t b : bins) {
+    Node& bin = bins_[b];
+    bin.untaken = 0;
+    bin.surface = 0.0;
+    bin.pca = PcaSums{};
+    for (std::uint32_t l = bin.begin; l < bin.end; ++l) {
+      bin.untaken += layers_[l].untaken;
+      bin.surface += layers_[l].surface;
+      bin.pca.addShifted(layers_[l].pca, (layers_[l].centre - bin.centre).cast<double>());
     }
   }
 }
 
 PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
   PlaneScore result;
-  const float offset = -plane.normal.dot(plane.point);
-  forEachSimilar(plane, [&](const Bin& bin, std::size_t k) {
-    const float surface = bin.surfaces[k];
-    result.similar += surface;
-    if (std::abs(plane.normal.dot(bin.points[k]) + offset) >= epsilon_) return;
-    result.score += surface;
-    result.pca.addBlock((bin.points[k] - plane.point).cast<double>(), bin.half_depths[k], surface);
-  });
+  const Query query{plane.normal, -plane.normal.dot(plane.point), cos_kappa_, epsilon_};
+  const Eigen::Vector3d origin = plane.point.cast<double>();
+  auto whole = [&](const Node& node) {
+    result.score += node.surface;
+    result.pca.addShifted(node.pca, node.centre.cast<double>() - origin);
+  };
+  auto blocks = [&](const Node& tile, Cone cone, Slab slab) {
+    for (std::uint32_t k = tile.begin; k < tile.end; ++k) {
+      if (order_taken_[k] != 0) continue;
+      if (cone != Cone::Inside) {
+        if (std::abs(block_directions_[k].dot(query.normal)) < cos_kappa_) continue;
+        result.similar += surfaces_[k];
+        if (slab == Slab::Outside) continue;
+      }
+      if (std::abs(query.normal.dot(points_[k]) + query.offset) >= epsilon_) continue;
+      result.score += surfaces_[k];
+      result.pca.addBlock((points_[k] - plane.point).cast<double>(), half_depths_[k], surfaces_[k]);
+    }
+  };
+  // Decides a node from its parent's verdicts; returns false when nothing inside remains to open.
+  auto decide = [&](const Node& node, const Eigen::Vector3f& frame_normal, Cone& cone, Slab& slab) {
+    if (node.untaken == 0) return false;
+    if (cone == Cone::Cut) cone = query.cone(node);
+    if (cone == Cone::Outside) return false;
+    if (slab == Slab::Cut) slab = query.slab(node, frame_normal);
+    if (cone == Cone::Inside) {
+      result.similar += node.surface;
+      if (slab == Slab::Outside) return false;
+      if (slab == Slab::Inside) {
+        whole(node);
+        return false;
+      }
+    }
+    return true;
+  };
+  for (std::size_t b = 0; b < bins_.size(); ++b) {
+    const Frame& frame = frames_[b];
+    const Eigen::Vector3f frame_normal(std::abs(frame.a.dot(query.normal)), std::abs(frame.u.dot(query.normal)),
+                                       std::abs(frame.v.dot(query.normal)));
+    Cone bin_cone = Cone::Cut;
+    Slab bin_slab = Slab::Cut;
+    if (!decide(bins_[b], frame_normal, bin_cone, bin_slab)) continue;
+    for (std::uint32_t l = bins_[b].begin; l < bins_[b].end; ++l) {
+      Cone layer_cone = bin_cone;
+      Slab layer_slab = bin_slab;
+      // Counted whole already: a node inside the cone adds its s_o once, at the top.
+      if (bin_cone == Cone::Inside && layer_slab == Slab::Cut) {
+        const Node& layer = layers_[l];
+        if (layer.untaken == 0) continue;
+        layer_slab = query.slab(layer, frame_normal);
+        if (layer_slab == Slab::Outside) continue;
+        if (layer_slab == Slab::Inside) {
+          whole(layer);
+          continue;
+        }
+      } else if (!decide(layers_[l], frame_normal, layer_cone, layer_slab)) {
+        continue;
+      }
+      for (std::uint32_t t = layers_[l].begin; t < layers_[l].end; ++t) {
+        Cone tile_cone = layer_cone;
+        Slab tile_slab = layer_slab;
+        const Node& tile = tiles_[t];
+        if (layer_cone == Cone::Inside) {
+          if (tile.untaken == 0) continue;
+          if (tile_slab == Slab::Cut) tile_slab = query.slab(tile, frame_normal);
+          if (tile_slab == Slab::Outside) continue;
+          if (tile_slab == Slab::Inside) {
+            whole(tile);
+            continue;
+          }
+        } else if (!decide(tile, frame_normal, tile_cone, tile_slab)) {
+          continue;
+        }
+        blocks(tile, tile_cone, tile_slab);
+      }
+    }
+  }
   return result;
 }
 
@@ -94,18 +319,45 @@ bool PlaneScorer::matches(std::uint32_t id, const CandidatePlane& plane) const {
 
 std::vector<std::uint32_t> PlaneScorer::matching(const CandidatePlane& plane) const {
   std::vector<std::uint32_t> ids;
-  const float offset = -plane.normal.dot(plane.point);
-  forEachSimilar(plane, [&](const Bin& bin, std::size_t k) {
-    if (std::abs(plane.normal.dot(bin.points[k]) + offset) < epsilon_) ids.push_back(bin.ids[k]);
-  });
+  const Query query{plane.normal, -plane.normal.dot(plane.point), cos_kappa_, epsilon_};
+  for (std::size_t b = 0; b < bins_.size(); ++b) {
+    const Frame& frame = frames_[b];
+    const Eigen::Vector3f frame_normal(std::abs(frame.a.dot(query.normal)), std::abs(frame.u.dot(query.normal)),
+                                       std::abs(frame.v.dot(query.normal)));
+    const Node& bin = bins_[b];
+    if (bin.untaken == 0 || query.cone(bin) == Cone::Outside || query.slab(bin, frame_normal) == Slab::Outside) continue;
+    for (std::uint32_t l = bin.begin; l < bin.end; ++l) {
+      const Node& layer = layers_[l];
+      if (layer.untaken == 0 || query.slab(layer, frame_normal) == Slab::Outside) continue;
+      for (std::uint32_t t = layer.begin; t < layer.end; ++t) {
+        const Node& tile = tiles_[t];
+        if (tile.untaken == 0 || query.slab(tile, frame_normal) == Slab::Outside) continue;
+        const Cone cone = query.cone(tile);
+        if (cone == Cone::Outside) continue;
+        for (std::uint32_t k = tile.begin; k < tile.end; ++k) {
+          if (order_taken_[k] != 0) continue;
+          if (cone == Cone::Cut && std::abs(block_directions_[k].dot(query.normal)) < cos_kappa_) continue;
+          if (std::abs(query.normal.dot(points_[k]) + query.offset) < epsilon_) ids.push_back(ids_[k]);
+        }
+      }
+    }
+  }
   std::sort(ids.begin(), ids.end());
   return ids;
 }
 
-void PlaneScorer::take(std::uint32_t id) {
-  taken_[id] = 1;
-  const auto [bin, index] = slot_[id];
-  if (bin != UINT32_MAX) bins_[bin].taken[index] = 1;
+void PlaneScorer::take(const std::vector<std::uint32_t>& ids) {
+  std::vector<std::uint32_t> dirty;
+  for (const std::uint32_t id : ids) {
+    taken_[id] = 1;
+    const std::uint32_t k = position_[id];
+    if (k == UINT32_MAX) continue;
+    order_taken_[k] = 1;
+    dirty.push_back(tile_of_[k]);
+  }
+  std::sort(dirty.begin(), dirty.end());
+  dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
+  refresh(dirty);
 }
 
 }  // namespace mlmap

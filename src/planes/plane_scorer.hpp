@@ -1,6 +1,16 @@
-// Internal to eRMSM: the blocks grouped by the orientation of their direction
-// vectors, so scoring a candidate plane reads only blocks whose direction can be
-// within κ of its normal; and the score pass itself (surface units, section V).
+// Internal to eRMSM: the score of a candidate plane (section V) — the surface, in
+// surface units, of the untaken blocks within ε of the plane whose direction vectors
+// lie within κ of its normal (s_c), and of all untaken blocks within κ (s_o, eq. 10).
+//
+// A pass over every block for every candidate costs most of the detection time on a
+// fine map, so the blocks are indexed: by the orientation of their direction vectors
+// (bins), inside a bin by their offset along the bin's axis (layers, ε/2 thick), inside
+// a layer by position (tiles, a few cells wide). Every node knows the cone of its
+// blocks' directions, the box of their points and the sums of its untaken blocks. A
+// node whose cone lies within κ of the plane's normal and whose box lies within the
+// slab |n·x + d| < ε counts whole; a node whose cone or box lies outside is skipped;
+// only the nodes the cone or the slab's faces cut are opened. The result is the score
+// of the paper's definition, block for block.
 #pragma once
 
 #include <Eigen/Core>
@@ -33,32 +43,53 @@ class PlaneScorer {
   std::vector<std::uint32_t> matching(const CandidatePlane& plane) const;
   bool matches(std::uint32_t id, const CandidatePlane& plane) const;
 
-  void take(std::uint32_t id);
+  // Takes the blocks out of the pool (an accepted plane's); the nodes' sums follow.
+  void take(const std::vector<std::uint32_t>& ids);
   bool taken(std::uint32_t id) const { return taken_[id] != 0; }
 
  private:
-  // A bin's blocks side by side in memory (structure of arrays), so a score pass
-  // streams through them instead of hopping around the block table.
-  struct Bin {
-    Eigen::Vector3f axis;  // unit centre of the bin
-    std::vector<std::uint32_t> ids;
-    std::vector<Eigen::Vector3f> points;
-    std::vector<Eigen::Vector3f> directions;
-    std::vector<float> surfaces;
-    std::vector<float> half_depths;  // 0 for horizontal blocks
-    std::vector<std::uint8_t> taken;
+  // A bin, a layer or a tile: its children are a run of the next level (a tile's are
+  // a run of the block arrays).
+  struct Node {
+    std::uint32_t begin = 0;
+    std::uint32_t end = 0;
+    Eigen::Vector3f axis = Eigen::Vector3f::UnitZ();  // unit mean direction of its blocks
+    float cos_radius = 1.0F;                          // cosine of the widest member direction from the axis
+    Eigen::Vector3f centre = Eigen::Vector3f::Zero();       // m, of its points' box
+    Eigen::Vector3f half_extent = Eigen::Vector3f::Zero();  // m, of the box along its bin's frame
+    std::uint32_t untaken = 0;
+    double surface = 0.0;  // untaken surface
+    PcaSums pca;           // untaken blocks, relative to centre
   };
-  template <typename Visit>
-  void forEachSimilar(const CandidatePlane& plane, Visit&& visit) const;
+  struct Frame {
+    Eigen::Vector3f a, u, v;  // the bin's axis and two directions across it
+  };
+  enum class Cone { Outside, Cut, Inside };
+  enum class Slab { Outside, Cut, Inside };
+  struct Query;
+
+  void refresh(const std::vector<std::uint32_t>& tiles);
 
   const BlockGrid& grid_;
   const std::vector<Eigen::Vector3f>& directions_;
   float epsilon_;
   float cos_kappa_;
-  float cos_bin_reach_;
-  std::vector<Bin> bins_;
-  std::vector<std::uint8_t> taken_;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> slot_;  // block id -> (bin, index)
+  std::vector<Node> bins_;    // children: layers
+  std::vector<Frame> frames_; // per bin
+  std::vector<Node> layers_;  // children: tiles
+  std::vector<Node> tiles_;   // children: blocks
+  // Blocks ordered by bin, layer, tile, id (structure of arrays: a pass streams).
+  std::vector<std::uint32_t> ids_;
+  std::vector<Eigen::Vector3f> points_;
+  std::vector<Eigen::Vector3f> block_directions_;
+  std::vector<float> surfaces_;
+  std::vector<float> half_depths_;  // 0 for horizontal blocks
+  std::vector<std::uint8_t> order_taken_;
+  std::vector<std::uint8_t> taken_;                 // by block id
+  std::vector<std::uint32_t> position_;             // block id -> index in the arrays, UINT32_MAX for none
+  std::vector<std::uint32_t> tile_of_;              // array index -> tile
+  std::vector<std::uint32_t> layer_of_tile_;
+  std::vector<std::uint32_t> bin_of_layer_;
 };
 
 }  // namespace mlmap

@@ -1,6 +1,15 @@
 // The blocks of an ML map as eRMSM sees them (section V): each block a point for
 // distances, its surface in surface units, its cell; and a dense grid over the
 // map's cells for neighbourhood queries in Chebyshev radius r.
+//
+// In cells finer than the gaps a scanner leaves on a surface, one surface section is
+// several map blocks: a wall's cell column at 2 cm holds a stack of short blocks
+// between the scan lines, and a floor cell two blocks either side of the range
+// noise (a point more than a cell from a block starts a new one, section IV). eRMSM
+// sees such a stack as one block: consecutive blocks of a cell closer than
+// `stack_gap` join, and the joined block is vertical only when it is deeper than
+// `level_band` (else it is level, at the inverse-variance mean of its members'
+// heights). The map itself is not changed; each eRMSM block names its map blocks.
 #pragma once
 
 #include <Eigen/Core>
@@ -17,19 +26,27 @@ struct PlaneBlock {
   float top = 0.0F;       // m, h
   float bottom = 0.0F;    // m, h − d
   float surface = 1.0F;   // surface units: 1 (horizontal) or d / cell_size (vertical)
-  bool vertical = false;  // a vertical block at least a cell deep (shallower ones count as horizontal)
+  bool vertical = false;  // deeper than the level band (shallower stacks count as horizontal)
   CellIndex cell;
+  std::uint16_t map_first = 0;  // its map blocks: [map_first, map_first + map_count) of the cell's list
+  std::uint16_t map_count = 1;
+};
+
+struct BlockGridConfig {
+  double stack_gap = 0.0;   // m, consecutive blocks of a cell closer than this are one eRMSM block
+  double level_band = 0.0;  // m, a block (or stack) no deeper than this is level; at least the cell size
 };
 
 class BlockGrid {
  public:
-  explicit BlockGrid(const MLMap& map);
+  explicit BlockGrid(const MLMap& map, const BlockGridConfig& config = {});
 
   double cellSize() const { return cell_size_; }
   const std::vector<PlaneBlock>& blocks() const { return blocks_; }
   std::size_t size() const { return blocks_.size(); }
 
-  // Block ids of the map's cell number n are [firstBlockOfCell(n), firstBlockOfCell(n + 1)).
+  // Block ids of the map's cell number n are [firstBlockOfCell(n), firstBlockOfCell(n + 1));
+  // each names its map blocks in the cell (PlaneBlock::map_first, map_count).
   std::uint32_t firstBlockOfCell(std::size_t cell_number) const { return cell_first_[cell_number]; }
 
   // Calls visit(block_id) for every block in cells within Chebyshev radius `radius` of `cell`.

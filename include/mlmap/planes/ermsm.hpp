@@ -14,7 +14,12 @@ namespace mlmap {
 
 struct ErmsmConfig {
   int radius = 2;                 // cells, Chebyshev radius r (direction vectors, candidate seeds)
-  double epsilon = 0.0;           // m, max block-plane distance ε; 0 = max(cell size, 0.02)
+  double epsilon = 0.0;           // m, max block-plane distance ε; 0 = max(cell size, min(3 σ, 0.05))
+  double noise = 0.0;             // m, σ of the points' range noise; 0 = the median of the map's vertical blocks' σ
+  // m: consecutive blocks of a cell closer than this are one eRMSM block (a wall's stack
+  // between scan lines in cells finer than their spacing); a stack no deeper than
+  // max(cell size, 5 σ) counts as level.
+  double stack_gap = 0.06;
   double kappa_deg = 25.0;        // deg, max angle between a block's direction and the plane, κ
   double theta_deg = 15.0;        // deg, max angle between the three seeds' directions, θ
   double min_probability = 0.99;  // p_t of eq. 10's acceptance test

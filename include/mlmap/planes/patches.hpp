@@ -23,9 +23,14 @@ void planeBasis(const Eigen::Vector3d& normal, Eigen::Vector3d& u, Eigen::Vector
 
 // Blocks are rasterised on a grid of cell_size in the plane (a vertical block over
 // its whole height); occupied grid cells within `gap_cells` (Chebyshev) of each other
-// are connected. Patches are returned largest first.
+// are connected. Patches are returned largest first, without outlines (outlineOf).
 std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
                                     const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
                                     int gap_cells = 2);
+
+// The outline of the blocks on the plane through `point`: the boundary loop of their
+// raster cells enclosing the most area, counter-clockwise about the normal, corners only.
+std::vector<Eigen::Vector3d> outlineOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
+                                       const Eigen::Vector3d& normal, const Eigen::Vector3d& point);
 
 }  // namespace mlmap

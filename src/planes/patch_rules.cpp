@@ -1,0 +1,70 @@
+#include "patch_rules.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "pca_sums.hpp"
+
+namespace mlmap {
+
+std::vector<std::uint32_t> withEdges(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
+                                     const PlaneScorer& scorer, std::vector<std::uint32_t> matching,
+                                     const CandidatePlane& plane, double epsilon, double kappa_rad) {
+  std::vector<std::uint8_t> in_plane(grid.size(), 0);
+  for (const std::uint32_t id : matching) in_plane[id] = 1;
+  const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * kappa_rad, std::numbers::pi / 2)));
+  const auto reach = static_cast<float>(epsilon);
+  std::vector<std::uint32_t> frontier = matching;
+  while (!frontier.empty()) {
+    std::vector<std::uint32_t> next;
+    for (const std::uint32_t id : frontier) {
+      grid.forEachNeighbour(grid.blocks()[id].cell, 1, [&](std::uint32_t other) {
+        if (in_plane[other] != 0 || scorer.taken(other)) return;
+        const Eigen::Vector3f& direction = directions[other];
+        if (direction.squaredNorm() > 0.0F && std::abs(direction.dot(plane.normal)) < cos_edge) return;
+        if (std::abs(plane.normal.dot(grid.blocks()[other].point - plane.point)) >= reach) return;
+        in_plane[other] = 1;
+        next.push_back(other);
+      });
+    }
+    matching.insert(matching.end(), next.begin(), next.end());
+    frontier = std::move(next);
+  }
+  std::sort(matching.begin(), matching.end());
+  return matching;
+}
+
+double directionSpread(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
+                       const std::vector<std::uint32_t>& ids, const CandidatePlane& plane) {
+  double weighted = 0.0;
+  double weight = 0.0;
+  for (const std::uint32_t id : ids) {
+    const double cosine = std::min(1.0F, std::abs(directions[id].dot(plane.normal)));
+    weighted += grid.blocks()[id].surface * std::acos(cosine);
+    weight += grid.blocks()[id].surface;
+  }
+  return weight > 0.0 ? weighted / weight * 180.0 / std::numbers::pi : 0.0;
+}
+
+bool isThin(const BlockGrid& grid, const Patch& patch, const CandidatePlane& plane, double min_width) {
+  PcaSums pca;
+  for (const std::uint32_t id : patch.blocks) {
+    const PlaneBlock& block = grid.blocks()[id];
+    pca.addBlock((block.point - plane.point).cast<double>(), block.vertical ? 0.5 * (block.top - block.bottom) : 0.0,
+                 1.0);
+  }
+  // The spread across the plane: the covariance in the plane's own basis.
+  Eigen::Vector3d u_axis;
+  Eigen::Vector3d v_axis;
+  planeBasis(plane.normal.cast<double>(), u_axis, v_axis);
+  Eigen::Matrix<double, 3, 2> basis;
+  basis << u_axis, v_axis;
+  const Eigen::Matrix2d in_plane = basis.transpose() * pca.covariance() * basis;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(in_plane);
+  const double minor = std::sqrt(std::max(0.0, solver.eigenvalues()(0)));
+  return minor < min_width;
+}
+
+}  // namespace mlmap

@@ -1,0 +1,35 @@
+// Internal to eRMSM, beyond the paper: the rules applied to an accepted plane before
+// its blocks leave the pool — its edge blocks, and the tests that tell a real plane's
+// patch from a curved surface's facet or a one-cell fringe.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "mlmap/planes/block_grid.hpp"
+#include "mlmap/planes/patches.hpp"
+#include "plane_scorer.hpp"
+
+namespace mlmap {
+
+// Blocks on the plane's edges, where a corner or a rim bends their direction vectors
+// past κ (or leaves them none), join the plane when they touch its matching blocks, lie
+// within ε and point within 2κ of it. Otherwise room corners are left over and later
+// form small diagonal "walls". Returns the ids ascending.
+std::vector<std::uint32_t> withEdges(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
+                                     const PlaneScorer& scorer, std::vector<std::uint32_t> matching,
+                                     const CandidatePlane& plane, double epsilon, double kappa_rad);
+
+// A curved surface (a pillar) fits planes only facet by facet, with directions fanning
+// out across each facet: a real plane's blocks agree with its normal. The mean angle,
+// in degrees, of the blocks' directions to the normal, weighted by surface.
+double directionSpread(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
+                       const std::vector<std::uint32_t>& ids, const CandidatePlane& plane);
+
+// A patch one cell wide is no surface: it is the fringe of a wall standing on a cell
+// boundary (stray points in the next column) or a line of clutter. True when its blocks
+// spread across the plane less than `min_width` (m, standard deviation) in some direction.
+bool isThin(const BlockGrid& grid, const Patch& patch, const CandidatePlane& plane, double min_width);
+
+}  // namespace mlmap

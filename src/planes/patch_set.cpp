@@ -1,0 +1,182 @@
+#include "patch_set.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "mlmap/planes/direction_vectors.hpp"
+#include "pca_sums.hpp"
+
+namespace mlmap {
+namespace {
+
+// Merges the planes that share a root (the root's index is the smallest of its
+// group); ids are renumbered in order and the block labels follow.
+void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::size_t>& roots, double kappa_rad) {
+  const std::vector<Plane>& planes = set.planes;
+  const std::size_t count = planes.size();
+  std::vector<Plane> merged;
+  std::vector<std::int32_t> new_id(count, 0);
+  for (std::size_t k = 0; k < count; ++k) {
+    if (roots[k] != k) continue;
+    std::size_t members = 0;
+    for (std::size_t member = 0; member < count; ++member) members += roots[member] == k ? 1 : 0;
+    Plane plane;
+    if (members == 1) {
+      plane = planes[k];  // alone: as it was
+    } else {
+      Patch patch;
+      for (std::size_t member = 0; member < count; ++member) {
+        if (roots[member] == k) patch.blocks.insert(patch.blocks.end(), set.blocks[member].begin(), set.blocks[member].end());
+      }
+      std::sort(patch.blocks.begin(), patch.blocks.end());
+      const Plane& largest = planes[k];
+      const CandidatePlane reference{largest.normal.cast<float>(), largest.centroid.cast<float>()};
+      for (const std::uint32_t id : patch.blocks) patch.surface += grid.blocks()[id].surface;
+      patch.outline = outlineOf(grid, patch.blocks, largest.normal, largest.centroid);
+      plane = describePatch(grid, patch, reference, kappa_rad);
+      plane.source = largest.source;
+      plane.candidates = largest.candidates;
+      plane.label = largest.label;
+    }
+    plane.id = static_cast<std::int32_t>(merged.size() + 1);
+    for (std::size_t member = 0; member < count; ++member) {
+      if (roots[member] == k) new_id[member] = plane.id;
+    }
+    merged.push_back(std::move(plane));
+  }
+  std::vector<std::vector<std::uint32_t>> merged_blocks(merged.size());
+  for (std::size_t k = 0; k < count; ++k) {
+    auto& blocks = merged_blocks[static_cast<std::size_t>(new_id[k] - 1)];
+    blocks.insert(blocks.end(), set.blocks[k].begin(), set.blocks[k].end());
+  }
+  for (auto& blocks : merged_blocks) std::sort(blocks.begin(), blocks.end());
+  set.planes = std::move(merged);
+  set.blocks = std::move(merged_blocks);
+  for (std::int32_t& label : set.labels) {
+    if (label > 0) label = new_id[static_cast<std::size_t>(label - 1)];
+  }
+}
+
+struct CellBox {
+  std::int32_t min_i = std::numeric_limits<std::int32_t>::max();
+  std::int32_t max_i = std::numeric_limits<std::int32_t>::min();
+  std::int32_t min_j = std::numeric_limits<std::int32_t>::max();
+  std::int32_t max_j = std::numeric_limits<std::int32_t>::min();
+};
+
+}  // namespace
+
+Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad) {
+  Plane plane;
+  const double cell_area = grid.cellSize() * grid.cellSize();
+  PcaSums pca;
+  const Eigen::Vector3d origin = reference.point.cast<double>();
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const std::uint32_t id : patch.blocks) {
+    const PlaneBlock& block = grid.blocks()[id];
+    centroid += block.point.cast<double>();
+    pca.addBlock(block.point.cast<double>() - origin, block.vertical ? 0.5 * (block.top - block.bottom) : 0.0,
+                 block.surface);
+  }
+  Eigen::Vector3d normal = reference.normal.cast<double>();
+  Eigen::Vector3d point = origin;
+  if (pca.weight >= 3.0) {
+    const Eigen::Vector3d mean = pca.mean();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(pca.covariance());
+    const Eigen::Vector3d fitted = solver.eigenvectors().col(0);
+    if (solver.eigenvalues()(1) > 1e-4 && std::abs(fitted.dot(normal)) > std::cos(kappa_rad)) normal = fitted;
+    point = origin + mean;
+  }
+  normal = orientConsistently(normal.cast<float>()).cast<double>();
+  plane.normal = normal;
+  plane.offset = -normal.dot(point);
+  plane.centroid = centroid / static_cast<double>(patch.blocks.size());
+  plane.area = patch.surface * cell_area;
+  plane.block_count = patch.blocks.size();
+  double squared = 0.0;
+  for (const std::uint32_t id : patch.blocks) {
+    const double distance = normal.dot(grid.blocks()[id].point.cast<double>()) + plane.offset;
+    squared += distance * distance;
+  }
+  plane.rms = std::sqrt(squared / static_cast<double>(patch.blocks.size()));
+  // The outline lies on the plane the patch was split on: put it on the patch's own.
+  for (const Eigen::Vector3d& corner : patch.outline) {
+    plane.outline.push_back(corner - normal * (normal.dot(corner) + plane.offset));
+  }
+  return plane;
+}
+
+void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad) {
+  const std::vector<Plane>& planes = set.planes;
+  const std::size_t count = planes.size();
+  std::vector<std::size_t> group(count);
+  for (std::size_t k = 0; k < count; ++k) group[k] = k;
+  auto root = [&](std::size_t k) {
+    while (group[k] != k) k = group[k] = group[group[k]];
+    return k;
+  };
+  const double cos_parallel = std::cos(0.5 * kappa_rad);
+  // Pieces closer than a table leg's width are one surface.
+  const int touch_radius = std::max(2, static_cast<int>(std::ceil(0.3 / grid.cellSize())));
+  std::vector<CellBox> boxes(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    for (const std::uint32_t id : set.blocks[k]) {
+      const CellIndex cell = grid.blocks()[id].cell;
+      boxes[k].min_i = std::min(boxes[k].min_i, cell.i);
+      boxes[k].max_i = std::max(boxes[k].max_i, cell.i);
+      boxes[k].min_j = std::min(boxes[k].min_j, cell.j);
+      boxes[k].max_j = std::max(boxes[k].max_j, cell.j);
+    }
+  }
+  for (std::size_t a = 0; a < count; ++a) {
+    for (std::size_t b = a + 1; b < count; ++b) {
+      const Plane& first = planes[a];
+      const Plane& second = planes[b];
+      if (std::abs(first.normal.dot(second.normal)) < cos_parallel) continue;
+      if (std::abs(first.normal.dot(second.centroid) + first.offset) >= epsilon ||
+          std::abs(second.normal.dot(first.centroid) + second.offset) >= epsilon) {
+        continue;
+      }
+      if (boxes[a].min_i - touch_radius > boxes[b].max_i || boxes[b].min_i - touch_radius > boxes[a].max_i ||
+          boxes[a].min_j - touch_radius > boxes[b].max_j || boxes[b].min_j - touch_radius > boxes[a].max_j) {
+        continue;
+      }
+      // Walk the smaller patch's neighbourhood looking for the larger one's label.
+      const bool a_smaller = set.blocks[a].size() <= set.blocks[b].size();
+      const auto& walked = set.blocks[a_smaller ? a : b];
+      const std::int32_t wanted = (a_smaller ? second : first).id;
+      bool touching = false;
+      for (const std::uint32_t id : walked) {
+        grid.forEachNeighbour(grid.blocks()[id].cell, touch_radius, [&](std::uint32_t other) {
+          if (set.labels[other] == wanted) touching = true;
+        });
+        if (touching) break;
+      }
+      if (touching) group[root(b)] = root(a);
+    }
+  }
+  std::vector<std::size_t> roots(count);
+  for (std::size_t k = 0; k < count; ++k) roots[k] = root(k);
+  mergeGroups(grid, set, roots, kappa_rad);
+}
+
+void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad) {
+  const std::vector<Plane>& planes = set.planes;
+  std::vector<std::size_t> roots(planes.size());
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    roots[k] = k;
+    if (planes[k].label != PlaneClass::Floor && planes[k].label != PlaneClass::Ceiling) continue;
+    for (std::size_t first = 0; first < k; ++first) {
+      if (planes[first].label == planes[k].label) {
+        roots[k] = first;
+        break;
+      }
+    }
+  }
+  mergeGroups(grid, set, roots, kappa_rad);
+}
+
+}  // namespace mlmap

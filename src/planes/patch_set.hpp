@@ -1,0 +1,36 @@
+// Internal to eRMSM, beyond the paper: the patches found so far — each a Plane with
+// its block ids — and the label of every block; describing a patch (its own plane
+// fit, area, RMS, outline) and merging patches that are one surface.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "mlmap/planes/block_grid.hpp"
+#include "mlmap/planes/patches.hpp"
+#include "mlmap/planes/plane.hpp"
+#include "plane_scorer.hpp"
+
+namespace mlmap {
+
+struct PatchSet {
+  std::vector<Plane> planes;                       // ids 1..n in order
+  std::vector<std::vector<std::uint32_t>> blocks;  // block ids of each plane, ascending
+  std::vector<std::int32_t> labels;                // per block id: its plane's id, 0 for none
+};
+
+// A Plane for the patch: refitted on its own blocks (two tables at slightly different
+// heights keep their own offsets) unless that fit is ill-defined or leaves `reference`
+// by more than κ; area, RMS, the outline moved onto the patch's own plane.
+Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad);
+
+// Patches of one real plane found apart (a refit that tilted a little, a wall on a
+// cell boundary) are merged when they are coplanar within ε, parallel within κ / 2
+// and touch on the grid.
+void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad);
+
+// After classification: floor and ceiling patches are one level each, however far
+// apart (a floor seen between furniture, a ceiling either side of a beam).
+void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad);
+
+}  // namespace mlmap
