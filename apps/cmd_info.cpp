@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
+#include <string>
 
 #include "commands.hpp"
 #include "mlmap/io/map_file.hpp"
@@ -43,6 +45,24 @@ int runInfo(const std::string& path, bool as_json) {
                       {"free_leaves", leaves - occupied}};
     info["memory_bytes"]["octree"] = tree.memoryUsage();
   }
+  // Planes by class, when the map is labelled (mlmap planes -o).
+  struct ClassTotal {
+    std::size_t patches = 0;
+    double area = 0.0;
+  };
+  std::map<std::string, ClassTotal> by_class;
+  if (map.planes()) {
+    for (const Plane& plane : map.planes()->planes) {
+      ClassTotal& total = by_class[std::string(className(plane.label))];
+      ++total.patches;
+      total.area += plane.area;
+    }
+    nlohmann::json classes = nlohmann::json::object();
+    for (const auto& [name, total] : by_class) classes[name] = {{"patches", total.patches}, {"area", total.area}};
+    info["planes"] = {{"patches", map.planes()->planes.size()},
+                      {"by_class", classes},
+                      {"detection_s", map.planes()->stats.direction_seconds + map.planes()->stats.detection_seconds}};
+  }
   if (as_json) {
     std::cout << info.dump(2) << "\n";
     return 0;
@@ -67,6 +87,14 @@ int runInfo(const std::string& path, bool as_json) {
   } else {
     std::printf("  OcTree         none (built with --no-octree)\n");
   }
+  if (!map.planes()) {
+    std::printf("  planes         none (label the map with `mlmap planes MAP -o LABELLED.mlmap`)\n");
+    return 0;
+  }
+  std::printf("  planes         %zu patches, detected in %.3f s\n", map.planes()->planes.size(),
+              static_cast<double>(info["planes"]["detection_s"]));
+  std::printf("    %-8s %8s %10s\n", "class", "patches", "area m²");
+  for (const auto& [name, total] : by_class) std::printf("    %-8s %8zu %10.1f\n", name.c_str(), total.patches, total.area);
   return 0;
 }
 
