@@ -69,13 +69,16 @@ int runMerge(const MergeArguments& arguments, bool quiet) {
   } else {
     printTransform(arguments.transform.empty() ? "transform (none given: same frame)" : "transform", other_to_base);
   }
-  if (!arguments.write_transform.empty()) io::writeTransform(arguments.write_transform, other_to_base);
 
   if (!quiet) std::fprintf(stderr, "merge: fusing blocks and OcTrees ...\n");
   const auto merge_start = std::chrono::steady_clock::now();
   const MergeStats stats = mergeInto(base, other, other_to_base, arguments.max_tilt_deg);
   const double merge_seconds = seconds(merge_start);
   io::writeMap(arguments.output, base);
+  if (!arguments.write_transform.empty()) {
+    double tilt_deg = 0.0;
+    io::writeTransform(arguments.write_transform, levelledTransform(other_to_base, tilt_deg));
+  }
   std::printf("  blocks: %zu + %zu -> %zu (%zu fewer than the sum: overlap fused)\n", stats.base_blocks,
               stats.other_blocks, stats.merged_blocks, stats.base_blocks + stats.other_blocks - stats.merged_blocks);
   std::printf("  cells:  %zu + %zu -> %zu\n", stats.base_cells, stats.other_cells, stats.merged_cells);
@@ -104,7 +107,7 @@ void addMergeCommand(CLI::App& app, Context& context) {
   command->add_option("--initial", arguments->initial, "Initial guess for --register (same formats as --transform)")
       ->check(CLI::ExistingFile)->needs(register_flag);
   command->add_flag("--force", arguments->force, "Merge even when the registration looks unreliable");
-  command->add_option("--write-transform", arguments->write_transform, "Write the transform used (4x4 matrix)");
+  command->add_option("--write-transform", arguments->write_transform, "Write the transform applied (levelled, 4x4 matrix)");
   command->add_option("--max-tilt", arguments->max_tilt_deg,
                       "Largest roll/pitch of the transform that is levelled away, deg (maps are gravity-aligned)")
       ->capture_default_str();

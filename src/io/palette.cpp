@@ -35,16 +35,4 @@ Rgb planeColour(std::int32_t plane_id) {
   return fromHsv(hue, 0.7, plane_id % 2 == 0 ? 0.8 : 0.95);
 }
 
-Rgb classColour(PlaneClass plane_class) {
-  switch (plane_class) {
-    case PlaneClass::Floor: return {196, 160, 110};
-    case PlaneClass::Ceiling: return {150, 190, 230};
-    case PlaneClass::Wall: return {235, 225, 200};
-    case PlaneClass::Table: return {70, 160, 90};
-    case PlaneClass::Step: return {230, 120, 40};
-    case PlaneClass::Other: return {180, 90, 180};
-  }
-  return kUnlabelledColour;
-}
-
 }  // namespace mlmap::io

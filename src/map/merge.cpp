@@ -22,8 +22,9 @@ CellIndex unpackCell(std::uint64_t packed) {
           static_cast<std::int32_t>(static_cast<std::uint32_t>(packed))};
 }
 
-// The transform without roll and pitch, and the tilt angle removed.
-Eigen::Isometry3d levelled(const Eigen::Isometry3d& transform, double& tilt_deg) {
+}  // namespace
+
+Eigen::Isometry3d levelledTransform(const Eigen::Isometry3d& transform, double& tilt_deg) {
   const Eigen::Vector3d up = transform.linear() * Eigen::Vector3d::UnitZ();
   tilt_deg = std::acos(std::clamp(up.z(), -1.0, 1.0)) * 180.0 / std::numbers::pi;
   const Eigen::Vector3d forward = transform.linear() * Eigen::Vector3d::UnitX();
@@ -33,6 +34,8 @@ Eigen::Isometry3d levelled(const Eigen::Isometry3d& transform, double& tilt_deg)
   result.translation() = transform.translation();
   return result;
 }
+
+namespace {
 
 void mergeBlocks(MLMap& base, const MLMap& other, const Eigen::Isometry3d& other_to_base) {
   // Pull resampling: every base cell whose centre falls inside an other cell takes
@@ -127,7 +130,7 @@ MergeStats mergeInto(Map& base, const Map& other, const Eigen::Isometry3d& other
     throw Error("cannot merge OcTrees of different resolutions: build both with the same --octree-resolution");
   }
   MergeStats stats;
-  const Eigen::Isometry3d transform = levelled(other_to_base, stats.dropped_tilt_deg);
+  const Eigen::Isometry3d transform = levelledTransform(other_to_base, stats.dropped_tilt_deg);
   if (stats.dropped_tilt_deg > max_tilt_deg) {
     throw Error("the transform tilts the other map by " + std::to_string(stats.dropped_tilt_deg) +
                 "°: ML maps are gravity-aligned, only yaw and translation can be merged (limit " +

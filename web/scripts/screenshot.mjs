@@ -1,6 +1,7 @@
 #!/usr/bin/env node
 // Renders the built dashboard (dist/index.html) with a planes JSON and saves a screenshot.
-// Usage: node scripts/screenshot.mjs PLANES.json OUT.png [WIDTHxHEIGHT]
+// Usage: node scripts/screenshot.mjs PLANES.json OUT.png [WIDTHxHEIGHT] [class|id]
+// (colour by id gives the colours of `mlmap export --octovis`)
 // Needs `npm run build` first and /usr/bin/chromium (or CHROMIUM=path).
 import { copyFile, mkdir, mkdtemp, readFile, rm, writeFile } from 'node:fs/promises';
 import { existsSync } from 'node:fs';
@@ -9,9 +10,9 @@ import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
 import { launchChromium, planesJs } from './browser.mjs';
 
-const [input, out, size = '1600x1000'] = process.argv.slice(2);
+const [input, out, size = '1600x1000', colourMode = 'class'] = process.argv.slice(2);
 if (!input || !out) {
-  console.error('usage: node scripts/screenshot.mjs PLANES.json OUT.png [WIDTHxHEIGHT]');
+  console.error('usage: node scripts/screenshot.mjs PLANES.json OUT.png [WIDTHxHEIGHT] [class|id]');
   process.exit(2);
 }
 const [width, height] = size.split('x').map(Number);
@@ -34,6 +35,7 @@ try {
   if ((await page.getAttribute('body', 'data-state')) !== 'ready') {
     throw new Error(`the dashboard did not load ${input}: ${await page.textContent('#message')}`);
   }
+  await page.selectOption('#colour-mode', colourMode);
   await page.waitForTimeout(300);
   await mkdir(path.dirname(path.resolve(out)), { recursive: true });
   await page.screenshot({ path: out });

@@ -4,8 +4,6 @@
 
 #include <cstdint>
 
-#include "mlmap/planes/plane.hpp"
-
 namespace mlmap::io {
 
 struct Rgb {
@@ -20,8 +18,5 @@ constexpr Rgb kUnlabelledColour{150, 150, 150};
 // Hues spread by the golden angle, so neighbouring ids differ strongly; id 0 (no
 // plane) is grey. The dashboard's "colour by id" uses the same formula.
 Rgb planeColour(std::int32_t plane_id);
-
-// One fixed colour per class (floor, ceiling, wall, table, step, other).
-Rgb classColour(PlaneClass plane_class);
 
 }  // namespace mlmap::io

@@ -22,6 +22,10 @@ struct MergeStats {
   double dropped_tilt_deg = 0.0;     // roll/pitch of the transform that was not applied
 };
 
+// The transform without its roll and pitch (yaw and translation kept); `tilt_deg`
+// receives the tilt removed.
+Eigen::Isometry3d levelledTransform(const Eigen::Isometry3d& transform, double& tilt_deg);
+
 // Merges `other` into `base`; `other_to_base` maps other's frame into base's. ML maps
 // are gravity-aligned, so only yaw and translation apply: a transform tilted by up to
 // `max_tilt_deg` is levelled (the tilt dropped is reported), a larger tilt throws
