@@ -11,55 +11,69 @@
 namespace mlmap {
 namespace {
 
-Eigen::Vector3f horizontalDirection(const BlockGrid& grid, std::uint32_t id, const DirectionConfig& config) {
-  const auto& blocks = grid.blocks();
-  const PlaneBlock& self = blocks[id];
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-  int count = 0;
-  // Coordinates relative to the block keep the sums well conditioned far from the origin.
-  grid.forEachNeighbour(self.cell, config.radius, [&](std::uint32_t other) {
-    const PlaneBlock& block = blocks[other];
-    if (block.vertical || std::abs(block.top - self.top) >= config.height_tolerance) return;
-    const Eigen::Vector3d p = (block.point - self.point).cast<double>();
-    sum += p;
-    outer += p * p.transpose();
-    ++count;
-  });
-  if (count < 3) return Eigen::Vector3f::Zero();
-  const Eigen::Vector3d mean = sum / count;
-  const Eigen::Matrix3d covariance = outer / count - mean * mean.transpose();
+// A neighbour as the blocks of one cell see it: offsets from the cell's centre.
+struct Neighbour {
+  float dx;
+  float dy;
+  float z;       // its point's height
+  float top;
+  float bottom;
+  bool vertical;
+};
+
+// Blocks of one cell share their neighbourhood: it is gathered once per cell, and the
+// sums are kept in float relative to the block (offsets of a few cells, heights of a
+// few centimetres), then solved in double.
+Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const std::vector<Neighbour>& neighbours,
+                                    float height_tolerance, double min_spread) {
+  float n = 0.0F, sx = 0.0F, sy = 0.0F, sz = 0.0F;
+  float xx = 0.0F, xy = 0.0F, xz = 0.0F, yy = 0.0F, yz = 0.0F, zz = 0.0F;
+  for (const Neighbour& other : neighbours) {
+    if (other.vertical || std::abs(other.top - self.top) >= height_tolerance) continue;
+    const float z = other.z - self.point.z();
+    n += 1.0F;
+    sx += other.dx;
+    sy += other.dy;
+    sz += z;
+    xx += other.dx * other.dx;
+    xy += other.dx * other.dy;
+    xz += other.dx * z;
+    yy += other.dy * other.dy;
+    yz += other.dy * z;
+    zz += z * z;
+  }
+  if (n < 3.0F) return Eigen::Vector3f::Zero();
+  const Eigen::Vector3d mean = Eigen::Vector3d(sx, sy, sz) / n;
+  Eigen::Matrix3d covariance;
+  covariance << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+  covariance = covariance / n - mean * mean.transpose();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(covariance);
   // The neighbourhood must spread in two directions, or its normal is arbitrary.
-  const double spread = 0.1 * grid.cellSize() * grid.cellSize();
-  if (solver.eigenvalues()(1) < spread) return Eigen::Vector3f::Zero();
+  if (solver.eigenvalues()(1) < min_spread) return Eigen::Vector3f::Zero();
   return orientConsistently(solver.eigenvectors().col(0).cast<float>());
 }
 
-Eigen::Vector3f verticalDirection(const BlockGrid& grid, std::uint32_t id, const DirectionConfig& config) {
-  const auto& blocks = grid.blocks();
-  const PlaneBlock& self = blocks[id];
-  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-  Eigen::Matrix2d outer = Eigen::Matrix2d::Zero();
-  int count = 0;
-  grid.forEachNeighbour(self.cell, config.radius, [&](std::uint32_t other) {
-    const PlaneBlock& block = blocks[other];
-    if (!block.vertical || block.bottom > self.top || block.top < self.bottom) return;
-    const Eigen::Vector2d p = (block.point.head<2>() - self.point.head<2>()).cast<double>();
-    sum += p;
-    outer += p * p.transpose();
-    ++count;
-  });
-  if (count < 2) return Eigen::Vector3f::Zero();
-  const Eigen::Vector2d mean = sum / count;
-  const Eigen::Matrix2d covariance = outer / count - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(covariance);
-  const double spread = 0.1 * grid.cellSize() * grid.cellSize();
-  if (solver.eigenvalues()(1) < spread) return Eigen::Vector3f::Zero();
+Eigen::Vector3f verticalDirection(const PlaneBlock& self, const std::vector<Neighbour>& neighbours, double min_spread) {
+  float n = 0.0F, sx = 0.0F, sy = 0.0F, xx = 0.0F, xy = 0.0F, yy = 0.0F;
+  for (const Neighbour& other : neighbours) {
+    if (!other.vertical || other.bottom > self.top || other.top < self.bottom) continue;
+    n += 1.0F;
+    sx += other.dx;
+    sy += other.dy;
+    xx += other.dx * other.dx;
+    xy += other.dx * other.dy;
+    yy += other.dy * other.dy;
+  }
+  if (n < 2.0F) return Eigen::Vector3f::Zero();
+  const Eigen::Vector2d mean = Eigen::Vector2d(sx, sy) / n;
+  Eigen::Matrix2d covariance;
+  covariance << xx, xy, xy, yy;
+  covariance = covariance / n - mean * mean.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(covariance);
+  if (solver.eigenvalues()(1) < min_spread) return Eigen::Vector3f::Zero();
   const Eigen::Vector2d normal = solver.eigenvectors().col(0);
-  return orientConsistently(Eigen::Vector3f(static_cast<float>(normal.x()),
-                                            static_cast<float>(normal.y()), 0.0F));
+  return orientConsistently(Eigen::Vector3f(static_cast<float>(normal.x()), static_cast<float>(normal.y()), 0.0F));
 }
 
 }  // namespace
@@ -81,16 +95,33 @@ Eigen::Vector3f orientConsistently(const Eigen::Vector3f& normal) {
 }
 
 std::vector<Eigen::Vector3f> directionVectors(const BlockGrid& grid, const DirectionConfig& config) {
-  std::vector<Eigen::Vector3f> directions(grid.size());
-  const auto count = static_cast<std::int64_t>(grid.size());
+  std::vector<Eigen::Vector3f> directions(grid.size(), Eigen::Vector3f::Zero());
+  const auto cells = static_cast<std::int64_t>(grid.cellCount());
+  const double min_spread = 0.1 * grid.cellSize() * grid.cellSize();
+  const auto& blocks = grid.blocks();
 #ifdef _OPENMP
   const int threads = config.threads > 0 ? config.threads : omp_get_max_threads();
 #endif
-#pragma omp parallel for schedule(dynamic, 1024) num_threads(threads)
-  for (std::int64_t k = 0; k < count; ++k) {
-    const auto id = static_cast<std::uint32_t>(k);
-    directions[id] = grid.blocks()[id].vertical ? verticalDirection(grid, id, config)
-                                                : horizontalDirection(grid, id, config);
+#pragma omp parallel num_threads(threads)
+  {
+    std::vector<Neighbour> neighbours;
+#pragma omp for schedule(dynamic, 256)
+    for (std::int64_t cell = 0; cell < cells; ++cell) {
+      const std::uint32_t begin = grid.firstBlockOfCell(static_cast<std::size_t>(cell));
+      const std::uint32_t end = grid.firstBlockOfCell(static_cast<std::size_t>(cell) + 1);
+      if (begin == end) continue;
+      const Eigen::Vector3f& centre = blocks[begin].point;
+      neighbours.clear();
+      grid.forEachNeighbour(blocks[begin].cell, config.radius, [&](std::uint32_t other) {
+        const PlaneBlock& block = blocks[other];
+        neighbours.push_back({block.point.x() - centre.x(), block.point.y() - centre.y(), block.point.z(), block.top,
+                              block.bottom, block.vertical});
+      });
+      for (std::uint32_t id = begin; id < end; ++id) {
+        directions[id] = blocks[id].vertical ? verticalDirection(blocks[id], neighbours, min_spread)
+                                             : horizontalDirection(blocks[id], neighbours, config.height_tolerance, min_spread);
+      }
+    }
   }
   return directions;
 }

@@ -232,7 +232,9 @@ PatchSet Detector::run(ErmsmStats& stats) {
     }
   }
   stats.accepted = static_cast<std::size_t>(accepted_);
-  mergeCoplanar(grid_, patches_, config_.epsilon, radians(config_.kappa_deg));
+  // Block points sit at cell centres: pieces of one surface lie up to half a cell
+  // further apart than ε allows a block.
+  mergeCoplanar(grid_, patches_, config_.epsilon + 0.5 * grid_.cellSize(), radians(config_.kappa_deg));
   return std::move(patches_);
 }
 

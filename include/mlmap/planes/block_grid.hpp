@@ -48,6 +48,7 @@ class BlockGrid {
   // Block ids of the map's cell number n are [firstBlockOfCell(n), firstBlockOfCell(n + 1));
   // each names its map blocks in the cell (PlaneBlock::map_first, map_count).
   std::uint32_t firstBlockOfCell(std::size_t cell_number) const { return cell_first_[cell_number]; }
+  std::size_t cellCount() const { return cell_first_.size() - 1; }
 
   // Calls visit(block_id) for every block in cells within Chebyshev radius `radius` of `cell`.
   template <typename Visit>

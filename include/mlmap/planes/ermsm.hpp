@@ -32,7 +32,7 @@ struct ErmsmConfig {
   double min_patch_area = 0.1;    // m², smaller connected patches go back to the pool
   int min_patch_blocks = 6;       // blocks, and so do patches of fewer blocks
   double min_patch_width_cells = 0.7;  // cells, and patches whose blocks spread less across (std-dev)
-  double max_direction_spread_deg = 10.0;  // deg, mean angle of a plane's blocks to its normal (curved surfaces fail)
+  double max_direction_spread_deg = 8.0;   // deg, mean angle of a plane's blocks to its normal (curved surfaces fail)
   int max_candidates = 4000;      // Max_cp: Algorithm 1 stops after this many candidates
   int max_idle_candidates = 300;  // ... or after this many without an accepted plane
   int batch_size = 16;            // candidates per iteration of Algorithm 1 (fixed, not per thread)
