@@ -54,8 +54,12 @@ void addPlanesCommand(CLI::App& app, Context& context) {
   command->add_option("--threads", config.threads, "Threads (default: all cores)")->check(CLI::NonNegativeNumber);
   command->add_option("--radius", config.radius, "r: neighbourhood radius, cells")
       ->capture_default_str()->check(CLI::PositiveNumber);
-  command->add_option("--epsilon", config.epsilon, "ε: max block-plane distance, m (default: the cell size, at least 0.02)")
+  command->add_option("--epsilon", config.epsilon, "ε: max block-plane distance, m (default: max(cell size, min(3 σ, 0.05)))")
       ->check(CLI::NonNegativeNumber);
+  command->add_option("--noise", config.noise, "σ: range noise of the map's points, m (default: from its vertical blocks)")
+      ->check(CLI::NonNegativeNumber);
+  command->add_option("--stack-gap", config.stack_gap, "A cell's blocks closer than this are one eRMSM block, m")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   command->add_option("--kappa", config.kappa_deg, "κ: max angle block direction / plane normal, deg")->capture_default_str();
   command->add_option("--theta", config.theta_deg, "θ: max angle between the seeds' directions, deg")->capture_default_str();
   command->add_option("--probability", config.min_probability, "p_t: acceptance probability (eq. 10)")->capture_default_str();

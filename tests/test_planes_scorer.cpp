@@ -1,0 +1,170 @@
+// eRMSM internals: the indexed plane score against a brute-force pass over every
+// block, the eRMSM view of a cell's block stack, and fine maps end to end.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+
+#include "../src/planes/plane_scorer.hpp"
+#include "mlmap/planes/block_grid.hpp"
+#include "mlmap/planes/direction_vectors.hpp"
+#include "mlmap/planes/ermsm.hpp"
+#include "plane_scenes.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+struct BruteScore {
+  double score = 0.0;
+  double similar = 0.0;
+  std::vector<std::uint32_t> matching;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();  // of the matching blocks' PCA points, relative to the plane's point
+};
+
+BruteScore bruteForce(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
+                      const std::vector<std::uint8_t>& taken, const CandidatePlane& plane, double epsilon,
+                      double kappa) {
+  BruteScore result;
+  PcaSums pca;
+  for (std::uint32_t id = 0; id < grid.size(); ++id) {
+    if (taken[id] != 0 || directions[id].squaredNorm() == 0.0F) continue;
+    if (std::abs(directions[id].dot(plane.normal)) < std::cos(kappa)) continue;
+    const PlaneBlock& block = grid.blocks()[id];
+    result.similar += block.surface;
+    if (std::abs(plane.normal.dot(block.point - plane.point)) >= epsilon) continue;
+    result.score += block.surface;
+    result.matching.push_back(id);
+    pca.addBlock((block.point - plane.point).cast<double>(), block.vertical ? 0.5 * (block.top - block.bottom) : 0.0,
+                 block.surface);
+  }
+  if (pca.weight > 0.0) result.mean = pca.mean();
+  return result;
+}
+
+// A room with a tilted ramp, a table and noise: blocks in many orientation bins.
+test::PlaneSceneBuilder scorerScene() {
+  test::PlaneSceneBuilder scene(0.05, 0.01, 3);
+  scene.floor(0.0, 0.0, 4.0, 3.0, 0.0).wallX(0.0, 0.0, 3.0, 0.0, 2.5).wallY(3.0, 0.0, 4.0, 0.0, 2.5);
+  scene.floor(1.0, 1.0, 2.0, 1.6, 0.72);
+  scene.rectangle({2.5, 0.2, 0.0}, {1.2, 0.0, 0.5}, {0.0, 1.0, 0.0}, 0.02);  // a ramp, 22.6°
+  scene.rectangle({3.5, 2.0, 0.0}, {0.3, 0.5, 0.0}, {0.0, 0.0, 1.0}, 0.02);  // a diagonal board
+  return scene;
+}
+
+}  // namespace
+
+TEST_CASE("PlaneScorer: scores, similar surfaces and matching blocks equal a brute-force pass, before and after takes") {
+  test::PlaneSceneBuilder scene = scorerScene();
+  const BlockGrid grid(scene.map());
+  DirectionConfig direction_config;
+  direction_config.height_tolerance = 0.05F;
+  const std::vector<Eigen::Vector3f> directions = directionVectors(grid, direction_config);
+  const double epsilon = 0.05;
+  const double kappa = 25.0 * M_PI / 180.0;
+  PlaneScorer scorer(grid, directions, epsilon, kappa);
+  std::vector<std::uint8_t> taken(grid.size(), 0);
+  std::mt19937 random(11);
+  std::uniform_int_distribution<std::uint32_t> any_block(0, static_cast<std::uint32_t>(grid.size() - 1));
+  std::normal_distribution<float> tilt(0.0F, 0.05F);
+  auto check = [&](int planes) {
+    for (int k = 0; k < planes; ++k) {
+      // Planes through a block, with its direction (or a random axis) slightly tilted.
+      const std::uint32_t id = any_block(random);
+      Eigen::Vector3f normal = directions[id].squaredNorm() > 0.0F ? directions[id] : Eigen::Vector3f::UnitZ();
+      if (k % 3 == 0) normal = Eigen::Vector3f(tilt(random), tilt(random), tilt(random)) * 20.0F;
+      normal = (normal + Eigen::Vector3f(tilt(random), tilt(random), tilt(random))).normalized();
+      const CandidatePlane plane{normal, grid.blocks()[id].point};
+      const PlaneScore fast = scorer.score(plane);
+      const BruteScore slow = bruteForce(grid, directions, taken, plane, epsilon, kappa);
+      CAPTURE(k);
+      CHECK(fast.score == doctest::Approx(slow.score).epsilon(1e-6));
+      CHECK(fast.similar == doctest::Approx(slow.similar).epsilon(1e-6));
+      CHECK(scorer.matching(plane) == slow.matching);
+      if (!slow.matching.empty()) CHECK((fast.pca.mean() - slow.mean).norm() < 1e-4);
+      for (const std::uint32_t other : slow.matching) CHECK(scorer.matches(other, plane));
+    }
+  };
+  check(300);
+  // Take the floor and a wall (as accepted planes would be), then every third block.
+  for (const CandidatePlane& plane : {CandidatePlane{Eigen::Vector3f::UnitZ(), Eigen::Vector3f::Zero()},
+                                      CandidatePlane{Eigen::Vector3f::UnitX(), Eigen::Vector3f::Zero()}}) {
+    const std::vector<std::uint32_t> ids = scorer.matching(plane);
+    REQUIRE(ids.size() > 100);
+    scorer.take(ids);
+    for (const std::uint32_t id : ids) taken[id] = 1;
+  }
+  std::vector<std::uint32_t> thirds;
+  for (std::uint32_t id = 0; id < grid.size(); id += 3) thirds.push_back(id);
+  scorer.take(thirds);
+  for (const std::uint32_t id : thirds) taken[id] = 1;
+  for (std::uint32_t id = 0; id < grid.size(); ++id) CHECK(scorer.taken(id) == (taken[id] != 0));
+  check(300);
+}
+
+TEST_CASE("BlockGrid: a wall's stack of short blocks between scan lines is one vertical eRMSM block per cell") {
+  // 2 cm cells, scan lines 4 cm apart on the wall: the map keeps a stack of blocks per cell.
+  MLMap map(0.02);
+  for (int line = 0; line <= 50; ++line) {
+    for (int step = 0; step <= 200; ++step) map.insert(Point(1.011, 0.005 * step, 0.04 * line), 1e-4);
+  }
+  std::size_t map_blocks_in_a_cell = map.blocks(map.cellOf(1.011, 0.5)).size();
+  REQUIRE(map_blocks_in_a_cell > 5);
+  const BlockGrid stacked(map, BlockGridConfig{0.06, 0.05});
+  const BlockGrid plain(map);
+  CHECK(plain.size() == map.blockCount());
+  CHECK(stacked.size() == map.cellCount());
+  for (const PlaneBlock& block : stacked.blocks()) {
+    CHECK(block.vertical);
+    CHECK(std::abs(block.bottom) < 1e-5);
+    CHECK(block.top == doctest::Approx(2.0).epsilon(1e-5));
+    CHECK(block.surface == doctest::Approx(2.0 / 0.02).epsilon(1e-4));
+    CHECK(block.map_first == 0);
+    CHECK(block.map_count == map.blocks(block.cell).size());
+  }
+}
+
+TEST_CASE("BlockGrid: two level blocks of a cell either side of the noise are one level block at their weighted height") {
+  MLMap map(0.02);
+  // Nine points at 0.0 and one 3 cm below: two horizontal blocks in one cell.
+  for (int k = 0; k < 9; ++k) map.insert(Point(0.01, 0.01, 0.0), 1e-4);
+  map.insert(Point(0.01, 0.01, -0.03), 1e-4);
+  REQUIRE(map.blockCount() == 2);
+  const BlockGrid grid(map, BlockGridConfig{0.06, 0.05});
+  REQUIRE(grid.size() == 1);
+  const PlaneBlock& block = grid.blocks()[0];
+  CHECK_FALSE(block.vertical);
+  CHECK(block.surface == 1.0F);
+  CHECK(block.map_count == 2);
+  // Weights 1/σ²: the nine-point block outweighs the stray one nine to one.
+  CHECK(std::abs(block.point.z() + 0.003) < 1e-4);
+}
+
+TEST_CASE("eRMSM: at 2 cm cells a wall seen every 4 cm and a noisy floor are two planes, every block labelled") {
+  test::PlaneSceneBuilder scene(0.02, 0.01, 5);
+  scene.floor(0.0, 0.0, 2.0, 2.0, 0.0);
+  MLMap& map = scene.map();
+  for (int line = 0; line <= 50; ++line) {
+    for (int step = 0; step <= 400; ++step) map.insert(Point(2.013, 0.005 * step, 0.04 * line + 0.02), 1e-4);
+  }
+  const PlaneDetection detection = detectPlanes(map);
+  REQUIRE(detection.planes.size() == 2);
+  int walls = 0;
+  for (const Plane& plane : detection.planes) {
+    const double tilt = std::acos(std::min(1.0, std::abs(plane.normal.z()))) * 180.0 / M_PI;
+    if (plane.label == PlaneClass::Wall) {
+      ++walls;
+      CHECK(std::abs(plane.normal.x()) > std::cos(1.0 * M_PI / 180.0));
+      CHECK(std::abs(std::abs(plane.offset) - 2.013) < 0.02);
+    } else {
+      CHECK(plane.label == PlaneClass::Floor);
+      CHECK(tilt < 1.0);
+      CHECK(std::abs(plane.offset) < 0.01);
+    }
+  }
+  CHECK(walls == 1);
+  // The wall's stacked map blocks all carry its label.
+  const std::int32_t wall_id =
+      detection.planes[0].label == PlaneClass::Wall ? detection.planes[0].id : detection.planes[1].id;
+  for (const Block& block : map.blocks(map.cellOf(2.013, 1.0))) CHECK(block.plane == wall_id);
+}
