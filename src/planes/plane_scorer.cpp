@@ -18,20 +18,27 @@ constexpr int kTileCells = 16;
 // Cones closer than this to κ are decided block by block (float rounding).
 constexpr float kCosMargin = 1e-5F;
 
-// Azimuth columns per elevation row, so that bins cover similar solid angles.
-int columnsOf(int row) {
-  if (row == kElevationRows - 1) return 1;
-  const double elevation = (row + 0.5) * (std::numbers::pi / 2) / kElevationRows;
-  return std::max(1, static_cast<int>(std::lround(36.0 * std::cos(elevation))));
+// Azimuth columns per elevation row, so that bins cover similar solid angles; and the
+// first bin of every row.
+struct BinLayout {
+  std::array<int, kElevationRows> columns{};
+  std::array<int, kElevationRows + 1> first{};
+  BinLayout() {
+    for (int row = 0; row < kElevationRows; ++row) {
+      const double elevation = (row + 0.5) * (std::numbers::pi / 2) / kElevationRows;
+      columns[static_cast<std::size_t>(row)] =
+          row == kElevationRows - 1 ? 1 : std::max(1, static_cast<int>(std::lround(36.0 * std::cos(elevation))));
+      first[static_cast<std::size_t>(row) + 1] = first[static_cast<std::size_t>(row)] + columns[static_cast<std::size_t>(row)];
+    }
+  }
+};
+
+const BinLayout& binLayout() {
+  static const BinLayout layout;
+  return layout;
 }
 
-int firstBinOf(int row) {
-  int first = 0;
-  for (int r = 0; r < row; ++r) first += columnsOf(r);
-  return first;
-}
-
-int binCount() { return firstBinOf(kElevationRows); }
+int binCount() { return binLayout().first[kElevationRows]; }
 
 int binOf(const Eigen::Vector3f& direction) {
   // Unsigned axes: use the upper hemisphere's representative.
@@ -40,9 +47,9 @@ int binOf(const Eigen::Vector3f& direction) {
   double azimuth = std::atan2(axis.y(), axis.x());
   if (azimuth < 0.0) azimuth += 2.0 * std::numbers::pi;
   const int row = std::min(kElevationRows - 1, static_cast<int>(elevation / (std::numbers::pi / 2) * kElevationRows));
-  const int columns = columnsOf(row);
+  const int columns = binLayout().columns[static_cast<std::size_t>(row)];
   const int column = std::min(columns - 1, static_cast<int>(azimuth / (2 * std::numbers::pi) * columns));
-  return firstBinOf(row) + column;
+  return binLayout().first[static_cast<std::size_t>(row)] + column;
 }
 
 }  // namespace

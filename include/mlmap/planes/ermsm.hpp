@@ -29,7 +29,7 @@ struct ErmsmConfig {
   // their orientation's surface (stair treads, risers) are never accepted.
   double acceptance_exponent = 1.0;
   double min_area = 0.15;         // m², s_m: a plane's minimal matched surface
-  double min_patch_area = 0.1;    // m², smaller connected patches go back to the pool
+  double min_patch_area = 0.15;   // m², smaller connected patches go back to the pool
   int min_patch_blocks = 6;       // blocks, and so do patches of fewer blocks
   double min_patch_width_cells = 0.7;  // cells, and patches whose blocks spread less across (std-dev)
   double max_direction_spread_deg = 8.0;   // deg, mean angle of a plane's blocks to its normal (curved surfaces fail)
