@@ -126,7 +126,7 @@ TEST_CASE("Export: the palette is stable, grey for no plane, and neighbouring id
   CHECK(colours.size() == 40);
 }
 
-TEST_CASE("Export: blocks PLY and .bt read back; a failed export leaves the old file alone") {
+TEST_CASE("Export: blocks PLY and .bt read back, a failed export leaves the old file alone") {
   const test::TempDir dir;
   const Map map = labelledRooms(true);
   io::writeBlocksPly(dir / "blocks.ply", map);

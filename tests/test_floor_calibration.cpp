@@ -73,7 +73,7 @@ TEST_CASE("Floor calibration recovers a simulated mounting tilt within 0.1 degre
   }
 }
 
-TEST_CASE("Floor calibration: mount.json round-trips; bad files and scans throw") {
+TEST_CASE("Floor calibration: mount.json round-trips, bad files and scans throw") {
   mlmap::test::TempDir dir;
   FloorCalibration calibration;
   calibration.correction.roll_correction_deg = 1.25;

@@ -142,7 +142,7 @@ TEST_CASE("ICP flags a featureless corridor as degenerate and keeps the guess al
   CHECK(result.pose.translation().x() - pair.true_pose.translation().x() > 0.2);
 }
 
-TEST_CASE("ICP: empty input gives an unreliable identity-free result; increments round-trip") {
+TEST_CASE("ICP: empty input gives an unreliable identity-free result, increments round-trip") {
   VoxelHashMap empty(0.1);
   const IcpResult result = alignPoints({Point(1, 0, 0)}, empty, Pose::Identity());
   CHECK(result.unreliable);

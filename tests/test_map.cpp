@@ -57,7 +57,7 @@ TEST_CASE("Map: rays cut at max_range clear free space but mark nothing occupied
   CHECK(map.blocks().blockCount() > 0);
 }
 
-TEST_CASE("Map: a block-only map has no OcTree; compact keeps both layers' content") {
+TEST_CASE("Map: a block-only map has no OcTree, compact keeps both layers' content") {
   MapConfig config;
   config.with_octree = false;
   Map blocks_only(config);

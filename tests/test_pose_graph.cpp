@@ -22,7 +22,7 @@ Pose pose(double x, double y, double z, double yaw_deg, double roll_deg = 0.0) {
 
 }  // namespace
 
-TEST_CASE("Pose graph: exact edges bring perturbed poses back; the first pose stays") {
+TEST_CASE("Pose graph: exact edges bring perturbed poses back, the first pose stays") {
   const std::vector<Pose> truth = {pose(20, 5, 1.2, 10), pose(22, 5.5, 1.2, 40), pose(23, 8, 1.25, 95, 1),
                                    pose(20.5, 9, 1.2, 170)};
   std::vector<PoseGraphEdge> edges;
@@ -52,7 +52,7 @@ TEST_CASE("Pose graph: exact edges bring perturbed poses back; the first pose st
   }
 }
 
-TEST_CASE("Pose graph: edge errors vanish at the measurement; bad edges throw") {
+TEST_CASE("Pose graph: edge errors vanish at the measurement, bad edges throw") {
   PoseGraphEdge edge;
   edge.from = 0;
   edge.to = 1;

@@ -89,7 +89,7 @@ TEST_CASE("SCIP timestamps: the 24-bit clock is unwrapped") {
   CHECK(unwrapper.unwrap(0x000020) == (1ull << 24) + 0x20);
 }
 
-TEST_CASE("SCIP client: PP with and without ';' in the sum, VV, II") {
+TEST_CASE("SCIP client: PP with and without a semicolon in the sum, VV, II") {
   FakeLaser laser;
   ScipClient client(*laser.client, std::chrono::milliseconds(300));
   // PP as a UTM-30LX answers (';' outside the sum), one line with it inside.

@@ -90,7 +90,7 @@ TEST_CASE("VoxelHashMap: nearest and within match brute force on a structured cl
   checkAgainstBruteForce(cloud, 0.05, 0.3, 7, 3.0);
 }
 
-TEST_CASE("VoxelHashMap: voxels keep at most max points; empty map finds nothing") {
+TEST_CASE("VoxelHashMap: voxels keep at most max points, empty map finds nothing") {
   VoxelHashMap map(0.5, 3);
   CHECK_FALSE(map.nearest(Point::Zero(), 10.0).has_value());
   std::vector<Point> same(10, Point(0.1, 0.1, 0.1));
