@@ -15,11 +15,13 @@
 #include "mlmap/driver/scip.hpp"
 #include "mlmap/io/map_file.hpp"
 #include "mlmap/io/pcd.hpp"
+#include "mlmap/io/planes_json.hpp"
 #include "mlmap/io/ply.hpp"
 #include "mlmap/io/scan_graph.hpp"
 #include "mlmap/io/threedtk.hpp"
 #include "mlmap/io/tum_poses.hpp"
 #include "mlmap/io/xyz.hpp"
+#include "mlmap/planes/ermsm.hpp"
 #include "mlmap/sim/scene.hpp"
 
 namespace fs = std::filesystem;
@@ -120,16 +122,37 @@ void fileSeeds(const Corpus& corpus) {
   }));
   corpus.add("graph", "ascii", "# plain ASCII log\nNODE 1 2 0.5 0 0 1.57\n1 0 0\n2 0 0\nNODE 0 0 0 0 0 0\n0 1 2\n");
 
+  const auto addMap = [&](const std::string& name, const Map& map) {
+    std::string bytes = corpus.made("a.mlmap", [&](auto& p) { io::writeMap(p, map); });
+    bytes.resize(bytes.size() - 4);  // the fuzz target appends the checksum
+    corpus.add("mlmap", name, bytes);
+  };
   for (const bool octree : {false, true}) {
     MapConfig config;
     config.cell_size = 0.5;
     config.with_octree = octree;
     Map map(config);
     map.insertScan(smallScan(12, false, 5));
-    std::string bytes = corpus.made("a.mlmap", [&](auto& p) { io::writeMap(p, map); });
-    bytes.resize(bytes.size() - 4);  // the fuzz target appends the checksum
-    corpus.add("mlmap", octree ? "with_octree" : "blocks_only", bytes);
+    addMap(octree ? "with_octree" : "blocks_only", map);
   }
+
+  // A labelled map and its planes export: a 1.5 m floor and a wall, in 10 cm cells.
+  MapConfig config;
+  config.cell_size = 0.1;
+  config.with_octree = false;
+  Map room(config);
+  Scan surfaces;
+  for (int i = 0; i < 15; ++i) {
+    for (int j = 0; j < 15; ++j) {
+      surfaces.points.emplace_back(0.05 + 0.1 * i, 0.05 + 0.1 * j, 0.0);
+      surfaces.points.emplace_back(0.05 + 0.1 * i, 0.02, 0.05 + 0.1 * j);
+    }
+  }
+  room.insertIntoBlocks(surfaces);
+  PlaneDetection detection = detectPlanes(room.blocks());
+  corpus.add("planes_json", "room", io::planesJson(room, detection, "room.mlmap"));
+  room.setPlanes(std::move(detection));
+  addMap("with_planes", room);
 }
 
 // ---------------------------------------------------------------- device replies
@@ -241,6 +264,13 @@ void rawLogSeed(const Corpus& corpus) {
   driver::PtuClient ptu(ptu_transport, std::chrono::milliseconds(options.timeout_ms));
   driver::acquireScan(laser, ptu, options, Pose::Identity());
   corpus.add("rawlog", "sweep", corpus.made("sweep.log", [&](auto& p) { log.save(p); }));
+  // The same devices' answers for the acquisition target: laser length, laser, PTU.
+  std::string laser_bytes, ptu_bytes;
+  for (const auto& record : log.records()) {
+    if (record.direction == 'r') (record.device == 'L' ? laser_bytes : ptu_bytes) += record.bytes;
+  }
+  std::string both = {static_cast<char>(laser_bytes.size() & 0xFF), static_cast<char>(laser_bytes.size() >> 8)};
+  corpus.add("acquisition", "sweep", both + laser_bytes + ptu_bytes);
 }
 
 }  // namespace
