@@ -49,8 +49,8 @@ struct ErmsmStats {
   std::size_t scored = 0;              // fully scored (the rest re-found a listed plane)
   std::size_t accepted = 0;            // accepted eRMSM planes (before the patch split)
   std::size_t labelled_blocks = 0;
-  double direction_seconds = 0.0;
-  double detection_seconds = 0.0;   // Algorithm 1 with refits and patch splitting
+  double direction_seconds = 0.0;   // noise estimate, eRMSM blocks and direction vectors
+  double detection_seconds = 0.0;   // Algorithm 1 with refits, patch split, merges, classes, labels
 };
 
 struct PlaneDetection {
