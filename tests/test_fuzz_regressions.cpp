@@ -8,10 +8,14 @@
 #include <cstring>
 #include <string>
 #include <string_view>
+#include <tuple>
 
 #include "helpers.hpp"
+#include "mlmap/driver/acquisition.hpp"
+#include "mlmap/driver/kinematics.hpp"
 #include "mlmap/driver/scip.hpp"
 #include "mlmap/driver/transport.hpp"
+#include "mlmap/io/planes_json.hpp"
 
 using namespace mlmap::driver;
 
@@ -51,4 +55,45 @@ TEST_CASE("fuzz regression scip_stream: a stream of nothing but acknowledgements
   laser.startScans(0, 99, 4, false);
   CHECK_THROWS_WITH_AS(laser.nextScan(), doctest::Contains("frames in a row without scan data"),
                        ScipError);
+}
+
+TEST_CASE("fuzz regression rawlog: integers in the sweep metadata that fit no integer") {
+  // Run through fuzz_rawlog (a hand-mutated seed; the fuzzer had not got there yet):
+  // json's get<int>() of 1e300, like get<unsigned>() of -1e300, is undefined behaviour
+  // (UBSan: "1e+300 is outside the range of representable values of type 'int'").
+  const std::string good = sweepToJson(SweepOptions{}, mlmap::Pose::Identity());
+  const auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string text = good;
+    const auto at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    return text.replace(at, from.size(), to);
+  };
+  SweepOptions options;
+  mlmap::Pose pose;
+  for (const auto& [from, to, key] :
+       {std::tuple{"\"timeout_ms\":1000", "\"timeout_ms\":1e300", "timeout_ms"},
+        std::tuple{"\"cluster\":1", "\"cluster\":-1e300", "cluster"},
+        std::tuple{"\"cluster\":1", "\"cluster\":-1", "cluster"},
+        std::tuple{"\"time_samples\":6", "\"time_samples\":4294967296", "time_samples"},
+        std::tuple{"\"time_samples\":6", "\"time_samples\":6.5", "time_samples"}}) {
+    CAPTURE(to);
+    CHECK_THROWS_WITH_AS(sweepFromJson(replaced(from, to), "sweep.log", options, pose),
+                         doctest::Contains((std::string("sweep.log: bad sweep metadata: ") + key).c_str()),
+                         mlmap::Error);
+  }
+  sweepFromJson(good, "sweep.log", options, pose);
+  CHECK(options.timeout_ms == 1000);
+}
+
+TEST_CASE("fuzz regression planes_json: a number too large for a double") {
+  // Found by fuzz_planes_json (a plane's value mutated to 0.9999E804496765137, minimised
+  // to "9E850"): nlohmann throws out_of_range, not parse_error, for a number that
+  // overflows, and it escaped the reader as a foreign exception. The same held for the
+  // mount configuration's reader.
+  CHECK_THROWS_WITH_AS(mlmap::io::parsePlanesJson("9E850", "planes.json"),
+                       doctest::Contains("planes.json: not valid JSON"), mlmap::Error);
+  CHECK_THROWS_WITH_AS(mlmap::io::parsePlanesJson(R"({"schema": 1e999})", "planes.json"),
+                       doctest::Contains("planes.json: not valid JSON"), mlmap::Error);
+  CHECK_THROWS_WITH_AS(parseMountConfig(R"({"tilt_axis_height": 1e999})", "mount.json"),
+                       doctest::Contains("mount.json: bad JSON"), mlmap::Error);
 }

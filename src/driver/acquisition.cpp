@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <tuple>
 
@@ -222,6 +223,29 @@ std::string sweepToJson(const SweepOptions& options, const Pose& odometry_pose) 
   return json.dump();
 }
 
+namespace {
+
+// An integer that fits `Integer`: json's own get<int>() of 1e300 or -1 into an unsigned
+// would be undefined behaviour or wrap.
+template <typename Integer>
+Integer integerField(const nlohmann::json& json, const char* key, const std::string& source_name) {
+  const nlohmann::json& value = json.at(key);
+  constexpr auto kMin = static_cast<std::int64_t>(std::numeric_limits<Integer>::min());
+  constexpr auto kMax = static_cast<std::uint64_t>(std::numeric_limits<Integer>::max());
+  static_assert(kMax <= static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()));
+  const bool fits = value.is_number_unsigned()  ? value.get<std::uint64_t>() <= kMax
+                    : value.is_number_integer() ? value.get<std::int64_t>() >= kMin &&
+                                                      value.get<std::int64_t>() <= static_cast<std::int64_t>(kMax)
+                                                : false;
+  if (!fits) {
+    throw Error(source_name + ": bad sweep metadata: " + key + " is not an integer from " +
+                std::to_string(kMin) + " to " + std::to_string(kMax));
+  }
+  return static_cast<Integer>(value.get<std::int64_t>());
+}
+
+}  // namespace
+
 void sweepFromJson(const std::string& json_text, const std::string& source_name,
                    SweepOptions& options, Pose& odometry_pose) {
   try {
@@ -232,9 +256,9 @@ void sweepFromJson(const std::string& json_text, const std::string& source_name,
     options.rho_deg = json.at("rho_deg").get<double>();
     options.base_speed_deg_s = json.at("base_speed_deg_s").get<double>();
     options.acceleration_deg_s2 = json.at("acceleration_deg_s2").get<double>();
-    options.cluster = json.at("cluster").get<std::uint32_t>();
-    options.time_samples = json.at("time_samples").get<int>();
-    options.timeout_ms = json.at("timeout_ms").get<int>();
+    options.cluster = integerField<std::uint32_t>(json, "cluster", source_name);
+    options.time_samples = integerField<int>(json, "time_samples", source_name);
+    options.timeout_ms = integerField<int>(json, "timeout_ms", source_name);
     options.mount = parseMountConfig(json.at("mount").dump(), source_name + ": mount");
     const auto matrix = json.at("odometry_pose").get<std::vector<double>>();
     if (matrix.size() != 16) throw Error(source_name + ": odometry_pose: expected 16 numbers");

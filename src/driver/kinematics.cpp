@@ -49,7 +49,7 @@ MountConfig parseMountConfig(std::string_view json_text, const std::string& sour
   nlohmann::json json;
   try {
     json = nlohmann::json::parse(json_text);
-  } catch (const nlohmann::json::parse_error& error) {
+  } catch (const nlohmann::json::exception& error) {  // parse_error, or out_of_range for 1e999
     throw Error(source_name + ": bad JSON: " + error.what());
   }
   if (!json.is_object()) throw Error(source_name + ": expected a JSON object");

@@ -149,8 +149,8 @@ PlaneDetection parsePlanesJson(std::string_view text, const std::string& name) {
   json document;
   try {
     document = json::parse(text);
-  } catch (const json::parse_error& error) {
-    // nlohmann's message carries the byte position.
+  } catch (const json::exception& error) {
+    // parse_error, or out_of_range for a number like 1e999; the message carries the byte.
     throw Error(name + ": not valid JSON: " + error.what());
   }
   const json& schema = reader.member(document, "top level", "schema");
