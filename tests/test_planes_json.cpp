@@ -132,3 +132,16 @@ TEST_CASE("PlanesJson: the reader refuses what is not an export, naming the elem
   json["timings"]["detection_s"] = "fast";
   refused(json, "timings.detection_s");
 }
+
+TEST_CASE("PlanesJson: integer parameters out of their type's range are refused, not converted") {
+  test::PlaneSceneBuilder scene(0.05);
+  scene.floor(0.0, 0.0, 3.0, 3.0, 0.0);
+  Map map(MapConfig{0.05, 0.0, -1.0, false});
+  map.blocks() = scene.map();
+  nlohmann::json json = nlohmann::json::parse(io::planesJson(map, detectPlanes(map.blocks()), "f.mlmap"));
+  CHECK(json["parameters"].contains("noise"));
+  CHECK(json["parameters"].contains("stack_gap"));
+  json["parameters"]["batch_size"] = 1e300;
+  CHECK_THROWS_WITH_AS(io::parsePlanesJson(json.dump(), "x.json"), doctest::Contains("parameters.batch_size: out of range"),
+                       Error);
+}

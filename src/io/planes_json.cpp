@@ -47,6 +47,8 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
                         {"batch_size", config.batch_size},
                         {"max_refits", config.max_refits},
                         {"refit_gain", config.refit_gain},
+                        {"noise", config.noise},
+                        {"stack_gap", config.stack_gap},
                         {"seed", config.seed}};
   const ErmsmStats& run = detection.stats;
   json["detection"] = {{"candidates", run.candidates},

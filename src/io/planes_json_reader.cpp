@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <type_traits>
 
 #include <nlohmann/json.hpp>
 
@@ -99,9 +100,17 @@ ErmsmConfig readParameters(const Reader& reader, const json& parameters) {
   config.seed = static_cast<std::uint64_t>(
       reader.integer(parameters, where, "seed", 0, std::numeric_limits<std::int64_t>::max()));
   const auto optional_number = [&](const char* key, auto& field) {
-    if (parameters.contains(key)) {
-      field = static_cast<std::remove_reference_t<decltype(field)>>(reader.number(parameters, where, key));
+    using Field = std::remove_reference_t<decltype(field)>;
+    if (!parameters.contains(key)) return;
+    const double value = reader.number(parameters, where, key);
+    if constexpr (std::is_integral_v<Field>) {
+      // A double outside the integer's range would make the conversion undefined.
+      if (!(value >= static_cast<double>(std::numeric_limits<Field>::min()) &&
+            value <= static_cast<double>(std::numeric_limits<Field>::max()))) {
+        reader.fail(where + "." + key, "out of range");
+      }
     }
+    field = static_cast<Field>(value);
   };
   optional_number("acceptance_exponent", config.acceptance_exponent);
   optional_number("min_patch_width_cells", config.min_patch_width_cells);
@@ -112,6 +121,8 @@ ErmsmConfig readParameters(const Reader& reader, const json& parameters) {
   optional_number("batch_size", config.batch_size);
   optional_number("max_refits", config.max_refits);
   optional_number("refit_gain", config.refit_gain);
+  optional_number("noise", config.noise);
+  optional_number("stack_gap", config.stack_gap);
   return config;
 }
 
