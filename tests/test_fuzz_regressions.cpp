@@ -16,6 +16,8 @@
 #include "mlmap/driver/scip.hpp"
 #include "mlmap/driver/transport.hpp"
 #include "mlmap/io/planes_json.hpp"
+#include "mlmap/registration/floor_calibration.hpp"
+#include "mlmap/sim/scene.hpp"
 
 using namespace mlmap::driver;
 
@@ -96,4 +98,15 @@ TEST_CASE("fuzz regression planes_json: a number too large for a double") {
                        doctest::Contains("planes.json: not valid JSON"), mlmap::Error);
   CHECK_THROWS_WITH_AS(parseMountConfig(R"({"tilt_axis_height": 1e999})", "mount.json"),
                        doctest::Contains("mount.json: bad JSON"), mlmap::Error);
+}
+
+TEST_CASE("Regression: a scene or a tilt file with 1e999 or a wrongly typed schema is a clear error") {
+  CHECK_THROWS_WITH_AS(mlmap::sim::parseScene(R"({"poses": [{"x": 1e999}], "surfaces": []})", "huge.json"),
+                       doctest::Contains("huge.json"), mlmap::Error);
+  mlmap::test::TempDir dir;
+  for (const char* text : {R"({"schema": 5})", R"({"schema": "mlmap.mount/1", "roll_correction_deg": 1e999})", "[1]"}) {
+    mlmap::test::writeText(dir / "tilt.json", text);
+    CHECK_THROWS_WITH_AS(mlmap::registration::readMountCorrection(dir / "tilt.json"), doctest::Contains("tilt.json"),
+                         mlmap::Error);
+  }
 }

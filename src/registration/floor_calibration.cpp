@@ -148,10 +148,11 @@ MountCorrection readMountCorrection(const std::filesystem::path& path) {
   nlohmann::json document;
   try {
     document = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& error) {
+  } catch (const nlohmann::json::exception& error) {  // parse_error, or out_of_range for 1e999
     throw Error(path.string() + ": not JSON (" + error.what() + ")");
   }
-  if (!document.is_object() || document.value("schema", "") != "mlmap.mount/1") {
+  const auto schema = document.is_object() ? document.find("schema") : document.end();
+  if (schema == document.end() || !schema->is_string() || schema->get<std::string>() != "mlmap.mount/1") {
     throw Error(path.string() + ": schema: expected \"mlmap.mount/1\"");
   }
   MountCorrection correction;

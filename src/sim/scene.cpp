@@ -480,8 +480,9 @@ Scene parseSceneElements(const JsonNode& root, bool poses_required, bool surface
 nlohmann::json parseSceneDocument(std::string_view json_text, const std::string& source) {
   try {
     return json::parse(json_text.begin(), json_text.end());
-  } catch (const json::parse_error& error) {
-    // nlohmann's message reads "[json.exception.parse_error.101] parse error at line 3, ..."
+  } catch (const json::exception& error) {
+    // parse_error, or out_of_range for a number like 1e999; nlohmann's message reads
+    // "[json.exception.parse_error.101] parse error at line 3, ..."
     std::string what = error.what();
     const auto bracket = what.find("] ");
     if (bracket != std::string::npos) what = what.substr(bracket + 2);
