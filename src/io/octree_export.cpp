@@ -8,6 +8,8 @@
 #include "mlmap/error.hpp"
 #include "mlmap/io/atomic_file.hpp"
 #include "mlmap/io/palette.hpp"
+#include "mlmap/map/surface_points.hpp"
+#include "../map/leaf_voxels.hpp"
 
 namespace mlmap::io {
 namespace {
@@ -43,6 +45,10 @@ std::int32_t planeAt(const MLMap& blocks, const Eigen::Vector3d& centre, double 
   return label;
 }
 
+octomap::point3d toPoint3d(const Eigen::Vector3d& point) {
+  return {static_cast<float>(point.x()), static_cast<float>(point.y()), static_cast<float>(point.z())};
+}
+
 void addVoxel(octomap::ColorOcTree& tree, const MLMap& blocks, const octomap::point3d& centre, float log_odds) {
   octomap::OcTreeKey key;
   if (!tree.coordToKeyChecked(centre, key)) return;
@@ -58,36 +64,16 @@ void voxelsFromOctree(octomap::ColorOcTree& tree, const Map& map) {
   for (auto leaf = source.begin_leafs(), end = source.end_leafs(); leaf != end; ++leaf) {
     if (!source.isNodeOccupied(*leaf)) continue;
     const float log_odds = leaf->getLogOdds();
-    // A pruned occupied leaf stands for all the voxels inside it.
-    const int per_axis = static_cast<int>(std::lround(leaf.getSize() / resolution));
-    const octomap::point3d corner = leaf.getCoordinate() - octomap::point3d(1, 1, 1) * (leaf.getSize() / 2.0F);
-    for (int a = 0; a < per_axis; ++a) {
-      for (int b = 0; b < per_axis; ++b) {
-        for (int c = 0; c < per_axis; ++c) {
-          const octomap::point3d offset(static_cast<float>((a + 0.5) * resolution),
-                                        static_cast<float>((b + 0.5) * resolution),
-                                        static_cast<float>((c + 0.5) * resolution));
-          addVoxel(tree, map.blocks(), corner + offset, log_odds);
-        }
-      }
-    }
+    forEachVoxelOfLeaf(leaf, resolution, [&](const Eigen::Vector3d& corner) {
+      addVoxel(tree, map.blocks(), toPoint3d(corner + Eigen::Vector3d::Constant(resolution / 2.0)), log_odds);
+    });
   }
 }
 
 void voxelsFromBlocks(octomap::ColorOcTree& tree, const MLMap& blocks) {
-  const double resolution = tree.getResolution();
   const float occupied = tree.getClampingThresMaxLog();
-  for (std::size_t n = 0; n < blocks.cellCount(); ++n) {
-    const Eigen::Vector2d xy = blocks.cellCenter(blocks.cellAt(n));
-    for (const Block& block : blocks.blocksAt(n)) {
-      const auto steps = static_cast<int>(std::floor(block.depth / resolution));
-      for (int k = 0; k <= steps; ++k) {
-        const double z = block.height - k * resolution;
-        addVoxel(tree, blocks,
-                 octomap::point3d(static_cast<float>(xy.x()), static_cast<float>(xy.y()), static_cast<float>(z)),
-                 occupied);
-      }
-    }
+  for (const Point& point : blockSurfacePoints(blocks, tree.getResolution())) {
+    addVoxel(tree, blocks, toPoint3d(point), occupied);
   }
 }
 

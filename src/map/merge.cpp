@@ -7,6 +7,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "leaf_voxels.hpp"
 #include "mlmap/error.hpp"
 
 namespace mlmap {
@@ -81,35 +82,25 @@ std::size_t fuseOctrees(octomap::OcTree& base, const octomap::OcTree& other, con
   for (auto leaf = other.begin_leafs(), end = other.end_leafs(); leaf != end; ++leaf) {
     const float log_odds = leaf->getLogOdds();
     const bool occupied = other.isNodeOccupied(*leaf);
-    const int per_axis = static_cast<int>(std::lround(leaf.getSize() / resolution));
-    const octomap::point3d corner = leaf.getCoordinate() - octomap::point3d(1, 1, 1) * (leaf.getSize() / 2.0F);
     const int samples = occupied && !pure_translation ? 2 : 1;
-    for (int a = 0; a < per_axis; ++a) {
-      for (int b = 0; b < per_axis; ++b) {
-        for (int c = 0; c < per_axis; ++c) {
-          keys.clear();
-          for (int sa = 0; sa < samples; ++sa) {
-            for (int sb = 0; sb < samples; ++sb) {
-              for (int sc = 0; sc < samples; ++sc) {
-                const auto offset = [&](int whole, int part) {
-                  return (whole + (part + 0.5) / samples) * resolution;
-                };
-                const Eigen::Vector3d local(corner.x() + offset(a, sa), corner.y() + offset(b, sb),
-                                            corner.z() + offset(c, sc));
-                const Eigen::Vector3d moved = other_to_base * local;
-                octomap::OcTreeKey key;
-                if (base.coordToKeyChecked(moved.x(), moved.y(), moved.z(), key) &&
-                    std::find(keys.begin(), keys.end(), key) == keys.end()) {
-                  keys.push_back(key);
-                }
-              }
+    forEachVoxelOfLeaf(leaf, resolution, [&](const Eigen::Vector3d& corner) {
+      keys.clear();
+      for (int sa = 0; sa < samples; ++sa) {
+        for (int sb = 0; sb < samples; ++sb) {
+          for (int sc = 0; sc < samples; ++sc) {
+            const Eigen::Vector3d sample = corner + resolution / samples * Eigen::Vector3d(sa + 0.5, sb + 0.5, sc + 0.5);
+            const Eigen::Vector3d moved = other_to_base * sample;
+            octomap::OcTreeKey key;
+            if (base.coordToKeyChecked(moved.x(), moved.y(), moved.z(), key) &&
+                std::find(keys.begin(), keys.end(), key) == keys.end()) {
+              keys.push_back(key);
             }
           }
-          for (const octomap::OcTreeKey& key : keys) base.updateNode(key, log_odds, true);
-          updates += keys.size();
         }
       }
-    }
+      for (const octomap::OcTreeKey& key : keys) base.updateNode(key, log_odds, true);
+      updates += keys.size();
+    });
   }
   base.updateInnerOccupancy();
   base.prune();

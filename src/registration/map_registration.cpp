@@ -3,22 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mlmap/map/surface_points.hpp"
 #include "mlmap/registration/preprocessing.hpp"
 
 namespace mlmap::registration {
-
-std::vector<Point> blockSurfacePoints(const MLMap& blocks, double spacing) {
-  std::vector<Point> points;
-  points.reserve(blocks.blockCount());
-  for (std::size_t n = 0; n < blocks.cellCount(); ++n) {
-    const Eigen::Vector2d xy = blocks.cellCenter(blocks.cellAt(n));
-    for (const Block& block : blocks.blocksAt(n)) {
-      const auto steps = static_cast<int>(std::floor(block.depth / spacing));
-      for (int k = 0; k <= steps; ++k) points.emplace_back(xy.x(), xy.y(), block.height - k * spacing);
-    }
-  }
-  return points;
-}
 
 MapRegistration registerMaps(const Map& base, const Map& other, const Pose& initial_guess,
                              const MapRegistrationConfig& config) {

@@ -29,10 +29,6 @@ struct MapRegistration {
   std::string reason;          // why not reliable; empty when reliable
 };
 
-// Surface samples of a map's blocks: a horizontal block's point, and a vertical
-// block's extent every `spacing` metres, at its cell centre.
-std::vector<Point> blockSurfacePoints(const MLMap& blocks, double spacing);
-
 MapRegistration registerMaps(const Map& base, const Map& other, const Pose& initial_guess,
                              const MapRegistrationConfig& config = {});
 
