@@ -1,5 +1,6 @@
 // mlmap label: every input point, in input order, in the world frame, with the patch
-// id of the block that collected it ("x y z id", −1 for none).
+// id of the block that collected it ("x y z id", −1 for none), refined point by point
+// against the patches' planes unless --block-labels.
 #include <cstdio>
 
 #include "commands.hpp"
@@ -18,6 +19,7 @@ struct LabelArguments {
   std::string poses;
   std::string output;
   std::vector<std::string> scans;
+  bool block_labels = false;
 };
 
 int runLabel(const LabelArguments& arguments, bool quiet) {
@@ -33,13 +35,20 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
         const std::vector<std::int32_t> labels = labelPoints(map.blocks(), scan);
         for (std::size_t k = 0; k < scan.size(); ++k) {
           labelled.points.push_back(scan.worldPoint(k));
-          // Blocks without a plane and points no block collects are both "none" here.
-          labelled.labels.push_back(labels[k] > 0 ? labels[k] : -1);
-          with_plane += labels[k] > 0 ? 1 : 0;
+          labelled.labels.push_back(labels[k]);
         }
       },
       [&](std::size_t file) { progress.update(file + 1); });
   progress.finish();
+  if (!arguments.block_labels && map.planes())
+    refinePointLabels(map.blocks(), map.planes()->planes, labelled.points, labelled.labels,
+                      PointLabelRefinement{.noise = map.planes()->config.noise,
+                                           .band = map.planes()->config.epsilon + 0.5 * map.blocks().cellSize()});
+  for (std::int32_t& label : labelled.labels) {
+    // Blocks without a plane and points no block collects are both "none" here.
+    if (label <= 0) label = -1;
+    with_plane += label > 0 ? 1 : 0;
+  }
   io::writeXyz(arguments.output, labelled);
   std::printf("%s: %zu points, %zu on a plane (%.1f %%)\n", arguments.output.c_str(), labelled.size(),
               with_plane, labelled.size() == 0 ? 0.0 : 100.0 * static_cast<double>(with_plane) / static_cast<double>(labelled.size()));
@@ -57,6 +66,9 @@ void addLabelCommand(CLI::App& app, Context& context) {
   command->add_option("--poses", arguments->poses, "TUM pose file, one pose per scan in order");
   command->add_option("-o,--output", arguments->output, "Points file to write (.xyz)")->required();
   command->add_option("scans", arguments->scans, "Scan files")->required()->check(CLI::ExistingFile);
+  command->add_flag("--block-labels", arguments->block_labels,
+                    "Give every point its block's label as is (default: a point keeps it only when it lies "
+                    "on the patch's plane, else takes a neighbouring block's patch it lies on, else none)");
   command->callback([arguments, &context] {
     context.run = [arguments, &context] { return runLabel(*arguments, context.quiet); };
   });

@@ -4,14 +4,44 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "mlmap/map/ml_map.hpp"
+#include "mlmap/planes/plane.hpp"
 
 namespace mlmap {
 
 // One label per scan point, in order: the collecting block's plane (0 when that block
 // matches no plane), or −1 when no block collects the point.
 std::vector<std::int32_t> labelPoints(const MLMap& map, const Scan& scan);
+
+struct PointLabelRefinement {
+  double noise = 0.0;           // m, σ of the points' range noise (the detection's), caps a patch's RMS; 0 = none
+  double sigmas = 3.0;          // a point lies on a plane within sigmas × the patch's RMS of it
+  double min_tolerance = 0.01;  // m, and always within this
+  double band = 0.0;            // m, the first refit takes the points this close to the detected
+                                // plane (e.g. ε + half a cell); 0 = all the patch's points
+};
+
+struct PointPlane {  // a patch's plane refitted to its points
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double offset = 0.0;      // n·x + offset = 0
+  double tolerance = 0.0;   // m, points farther are not on it
+  std::size_t points = 0;   // points that fitted it
+};
+
+// Block labels are cell-sized: a block at a corner or an edge holds points of two
+// surfaces, and all of them take the block's patch. This pass refits every patch's
+// plane to its labelled points (first those within `band` of the detected plane, then
+// those within tolerance of the first fit); then every point takes the nearest of the patches it lies on (within
+// tolerance of the plane) among its block's and those of the blocks of its own and
+// the 8 neighbouring cells that reach its height, or none (0) if it lies on none.
+// `labels` are labelPoints' (any value ≤ 0 is "none"); `points` are world points.
+// Returns the refitted planes, indexed by patch id (index 0 unused). Deterministic
+// at any thread count.
+std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plane> planes,
+                                          std::span<const Point> points, std::span<std::int32_t> labels,
+                                          const PointLabelRefinement& options = {});
 
 }  // namespace mlmap

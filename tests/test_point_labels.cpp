@@ -1,0 +1,137 @@
+// Per-point labels: the collecting block's patch, then refined point by point against
+// the patches' planes (a block at an edge holds points of two surfaces).
+#include <doctest/doctest.h>
+
+#include <random>
+
+#ifdef MLMAP_HAVE_OPENMP
+#include <omp.h>
+#endif
+
+#include "mlmap/planes/ermsm.hpp"
+#include "mlmap/planes/point_labels.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+// A floor (z = 0) meeting a wall at x = 1.98, i.e. inside the cells 1.95–2.00 m at
+// 5 cm: those cells' floor points join the wall's vertical blocks. The scan holds
+// every point the map was built from.
+struct Corner {
+  MLMap map{0.05};
+  Scan scan;
+  PlaneDetection detection;
+  std::int32_t floor_id = 0;
+  std::int32_t wall_id = 0;
+
+  Corner() {
+    std::mt19937 random(7);
+    std::normal_distribution<double> noise(0.0, 0.003);
+    for (int a = 0; a < 198; ++a)
+      for (int b = 0; b <= 200; ++b) scan.points.emplace_back(0.01 * a, 0.01 * b, noise(random));
+    for (int b = 0; b <= 200; ++b)
+      for (int c = 0; c <= 150; ++c) scan.points.emplace_back(1.98 + noise(random), 0.01 * b, 0.01 * c);
+    for (const Point& p : scan.points) map.insert(p, 1e-4);
+    detection = detectPlanes(map);
+    for (const Plane& plane : detection.planes) {
+      if (plane.label == PlaneClass::Floor) floor_id = plane.id;
+      if (plane.label == PlaneClass::Wall) wall_id = plane.id;
+    }
+  }
+
+  PointLabelRefinement options() const {
+    return PointLabelRefinement{.band = detection.config.epsilon + 0.5 * map.cellSize()};
+  }
+};
+
+}  // namespace
+
+TEST_CASE("Point labels: floor points in the wall's corner blocks leave the wall for the floor") {
+  Corner corner;
+  REQUIRE(corner.floor_id > 0);
+  REQUIRE(corner.wall_id > 0);
+  const Scan& scan = corner.scan;
+  std::vector<std::int32_t> labels = labelPoints(corner.map, scan);
+  // The situation this pass exists for: the block rule gives the corner cells' floor
+  // points (x 1.95–1.97 m, 1–3 cm off the wall) to the wall.
+  const auto corner_floor = [&scan](std::size_t k) {
+    return scan.points[k].x() >= 1.95 && scan.points[k].x() < 1.965 && std::abs(scan.points[k].z()) < 0.01;
+  };
+  int corner_floor_points = 0;
+  int on_the_wall_before = 0;
+  for (std::size_t k = 0; k < scan.size(); ++k) {
+    if (!corner_floor(k)) continue;
+    ++corner_floor_points;
+    on_the_wall_before += labels[k] == corner.wall_id;
+  }
+  REQUIRE(corner_floor_points > 300);
+  REQUIRE(on_the_wall_before > corner_floor_points * 9 / 10);
+
+  const auto planes = refinePointLabels(corner.map, corner.detection.planes, scan.points, labels, corner.options());
+  int floor_after = 0;
+  int wall_points = 0;
+  int wall_points_on_the_wall = 0;
+  for (std::size_t k = 0; k < scan.size(); ++k) {
+    if (corner_floor(k)) floor_after += labels[k] == corner.floor_id;
+    if (scan.points[k].z() > 0.05 && scan.points[k].x() > 1.9) {
+      ++wall_points;
+      wall_points_on_the_wall += labels[k] == corner.wall_id;
+    }
+  }
+  CHECK(floor_after > corner_floor_points * 99 / 100);
+  CHECK(wall_points_on_the_wall > wall_points * 99 / 100);
+  // The refitted planes are the true ones, tolerance a few noise σ.
+  const PointPlane& floor = planes[static_cast<std::size_t>(corner.floor_id)];
+  CHECK(std::abs(floor.normal.z()) > std::cos(0.2 * M_PI / 180.0));
+  CHECK(std::abs(floor.offset) < 0.002);
+  CHECK(floor.tolerance < 0.02);
+  const PointPlane& wall = planes[static_cast<std::size_t>(corner.wall_id)];
+  CHECK(std::abs(wall.normal.x()) > std::cos(0.2 * M_PI / 180.0));
+  CHECK(std::abs(std::abs(wall.offset) - 1.98) < 0.002);
+}
+
+TEST_CASE("Point labels: a point on no patch's plane gets none, and a point beside a patch gets it") {
+  Corner corner;
+  Scan scan;
+  scan.points = {Point(1.0, 1.0, 0.04),     // 4 cm above the floor: its block collects it, its plane does not
+                 Point(1.0, 1.0, 0.001),    // on the floor
+                 Point(5.0, 5.0, 0.0)};     // beyond the map
+  std::vector<std::int32_t> labels = labelPoints(corner.map, scan);
+  CHECK(labels[0] == corner.floor_id);
+  refinePointLabels(corner.map, corner.detection.planes, scan.points, labels, corner.options());
+  CHECK(labels[0] == 0);
+  CHECK(labels[1] == corner.floor_id);
+  CHECK(labels[2] == -1);
+}
+
+TEST_CASE("Point labels: patch ids the plane list does not know, and a hostile plane list, give none") {
+  Corner corner;
+  const Scan& scan = corner.scan;
+  std::vector<Plane> planes = corner.detection.planes;
+  for (Plane& plane : planes) plane.id += 1000;  // no block carries these ids
+  planes.push_back(Plane{});
+  planes.back().id = -5;
+  planes.back().normal = Eigen::Vector3d::Zero();
+  planes.back().offset = std::nan("");
+  std::vector<std::int32_t> labels = labelPoints(corner.map, scan);
+  refinePointLabels(corner.map, planes, scan.points, labels);
+  for (const std::int32_t label : labels) CHECK(label <= 0);
+}
+
+#ifdef MLMAP_HAVE_OPENMP
+TEST_CASE("Point labels: the refinement gives the same labels at 1 and 2 threads") {
+  Corner corner;
+  const Scan& scan = corner.scan;
+  std::vector<std::vector<std::int32_t>> runs;
+  const int threads = omp_get_max_threads();
+  for (const int count : {1, 2}) {
+    omp_set_num_threads(count);
+    std::vector<std::int32_t> labels = labelPoints(corner.map, scan);
+    refinePointLabels(corner.map, corner.detection.planes, scan.points, labels, corner.options());
+    runs.push_back(labels);
+  }
+  omp_set_num_threads(threads);
+  CHECK(runs[0] == runs[1]);
+}
+#endif
