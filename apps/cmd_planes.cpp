@@ -60,6 +60,11 @@ void addPlanesCommand(CLI::App& app, Context& context) {
       ->check(CLI::NonNegativeNumber);
   command->add_option("--stack-gap", config.stack_gap, "A cell's blocks closer than this are one eRMSM block, m")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
+  command->add_option("--ladder-gap", config.ladder_gap,
+                      "A ladder of short blocks of a cell less than this apart is one eRMSM block (sparse scan lines), m; 0 = off")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  command->add_option("--ladder-blocks", config.ladder_blocks, "Blocks a ladder needs at least")
+      ->capture_default_str()->check(CLI::Range(2, 1000));
   command->add_option("--kappa", config.kappa_deg, "κ: max angle block direction / plane normal, deg")->capture_default_str();
   command->add_option("--theta", config.theta_deg, "θ: max angle between the seeds' directions, deg")->capture_default_str();
   command->add_option("--probability", config.min_probability, "p_t: acceptance probability (eq. 10)")->capture_default_str();

@@ -168,3 +168,68 @@ TEST_CASE("eRMSM: at 2 cm cells a wall seen every 4 cm and a noisy floor are two
       detection.planes[0].label == PlaneClass::Wall ? detection.planes[0].id : detection.planes[1].id;
   for (const Block& block : map.blocks(map.cellOf(2.013, 1.0))) CHECK(block.plane == wall_id);
 }
+
+TEST_CASE("BlockGrid: a ladder of single scan lines up a cell is one vertical block, a few far-apart blocks are not") {
+  // 5 cm cells, scan lines 12 cm apart: every line is its own one-point level block.
+  MLMap map(0.05);
+  for (int line = 0; line < 10; ++line) map.insert(Point(0.02, 0.02, 0.1 + 0.12 * line), 1e-4);
+  for (int line = 0; line < 4; ++line) map.insert(Point(0.22, 0.02, 0.1 + 0.12 * line), 1e-4);
+  REQUIRE(map.blocks(map.cellOf(0.02, 0.02)).size() == 10);
+  const BlockGridConfig config{.stack_gap = 0.06, .level_band = 0.05, .ladder_gap = 0.2, .ladder_blocks = 6,
+                               .rung_variance = 1e-5};
+  const BlockGrid grid(map, config);
+  REQUIRE(grid.size() == 1 + 4);
+  const PlaneBlock& ladder = grid.blocks()[grid.firstBlockOfCell(*map.cellNumber(map.cellOf(0.02, 0.02)))];
+  CHECK(ladder.vertical);
+  CHECK(ladder.bottom == doctest::Approx(0.1).epsilon(1e-5));
+  CHECK(ladder.top == doctest::Approx(1.18).epsilon(1e-5));
+  CHECK(ladder.surface == doctest::Approx(1.08 / 0.05).epsilon(1e-4));
+  CHECK(ladder.map_count == 10);
+  // Four rungs are fewer than a ladder needs: four level blocks.
+  const auto four = *map.cellNumber(map.cellOf(0.22, 0.02));
+  for (std::uint32_t id = grid.firstBlockOfCell(four); id < grid.firstBlockOfCell(four + 1); ++id) {
+    CHECK_FALSE(grid.blocks()[id].vertical);
+  }
+  // Without ladders the ten stay apart.
+  CHECK(BlockGrid(map, BlockGridConfig{.stack_gap = 0.06, .level_band = 0.05}).size() == 10 + 4);
+}
+
+TEST_CASE("BlockGrid: a table top fused from many points is no rung of the sparse ladder below it") {
+  MLMap map(0.05);
+  for (int line = 0; line < 6; ++line) map.insert(Point(0.02, 0.02, 0.05 + 0.12 * line), 1e-4);
+  for (int k = 0; k < 50; ++k) map.insert(Point(0.02, 0.02, 0.80), 1e-4);  // the top, 15 cm above the last rung
+  const BlockGridConfig config{.stack_gap = 0.06, .level_band = 0.05, .ladder_gap = 0.2, .ladder_blocks = 6,
+                               .rung_variance = 1e-5};
+  const BlockGrid grid(map, config);
+  REQUIRE(grid.size() == 2);
+  CHECK(grid.blocks()[0].vertical);
+  CHECK(grid.blocks()[0].map_count == 6);
+  CHECK_FALSE(grid.blocks()[1].vertical);
+  CHECK(grid.blocks()[1].top == doctest::Approx(0.80).epsilon(1e-5));
+}
+
+TEST_CASE("eRMSM: a wall seen by scan lines 12 cm apart at 5 cm cells is found, through its ladders") {
+  // Every line is a one-point level block per cell: without ladders no vertical block.
+  test::PlaneSceneBuilder scene(0.05, 0.005, 11);
+  scene.floor(0.0, 0.0, 3.0, 3.0, 0.0);
+  MLMap& map = scene.map();
+  std::mt19937 random(4);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  for (int line = 0; line < 20; ++line) {
+    for (int step = 0; step < 60; ++step) map.insert(Point(3.013 + noise(random), 0.05 * step + 0.025, 0.1 + 0.12 * line), 1e-4);
+  }
+  const auto walls = [](const PlaneDetection& detection) {
+    std::vector<Plane> found;
+    for (const Plane& plane : detection.planes)
+      if (plane.label == PlaneClass::Wall) found.push_back(plane);
+    return found;
+  };
+  ErmsmConfig without;
+  without.ladder_gap = 0.0;
+  CHECK(walls(detectPlanes(map, without)).empty());
+  const std::vector<Plane> found = walls(detectPlanes(map));
+  REQUIRE(found.size() == 1);
+  CHECK(std::abs(found[0].normal.x()) > std::cos(1.0 * M_PI / 180.0));
+  CHECK(std::abs(std::abs(found[0].offset) - 3.013) < 0.03);
+  CHECK(found[0].area > 0.8 * 3.0 * 2.3);
+}

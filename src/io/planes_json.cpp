@@ -49,6 +49,8 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
                         {"refit_gain", config.refit_gain},
                         {"noise", config.noise},
                         {"stack_gap", config.stack_gap},
+                        {"ladder_gap", config.ladder_gap},
+                        {"ladder_blocks", config.ladder_blocks},
                         {"seed", config.seed}};
   const ErmsmStats& run = detection.stats;
   json["detection"] = {{"candidates", run.candidates},

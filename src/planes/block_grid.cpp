@@ -9,6 +9,9 @@ namespace mlmap {
 
 BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_size_(map.cellSize()) {
   const auto stack_gap = static_cast<float>(config.stack_gap);
+  const auto ladder_gap = static_cast<float>(config.ladder_gap);
+  const auto ladder_blocks = static_cast<std::size_t>(std::max(config.ladder_blocks, 2));
+  const auto rung_variance = static_cast<float>(config.rung_variance);
   const auto level_band = static_cast<float>(std::max(config.level_band, cell_size_));
   const std::size_t cell_count = map.cellCount();
   blocks_.reserve(map.blockCount());
@@ -23,9 +26,29 @@ BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_siz
     const Eigen::Vector2d centre = map.cellCenter(cell);
     const std::span<const Block> cell_blocks = map.blocksAt(n);
     for (std::size_t first = 0; first < cell_blocks.size();) {
-      // The stack: this block and the ones above it closer than the stack gap.
+      // The stack: this block and the ones above it closer than the stack gap, or a
+      // ladder of short blocks, then whatever lies closer than the stack gap above it.
       std::size_t last = first;
       float top = cell_blocks[first].height;
+      // A rung is a sliver of one or two scan lines: short, and if level, fused from a
+      // few points only (a table top or a seat is fused from many: not a rung).
+      const auto short_block = [&](std::size_t k) {
+        const Block& block = cell_blocks[k];
+        return block.depth < ladder_gap && (block.isVertical() || block.variance > rung_variance);
+      };
+      if (short_block(first)) {
+        std::size_t rung = first;
+        float rung_top = top;
+        while (rung + 1 < cell_blocks.size() && short_block(rung + 1) &&
+               cell_blocks[rung + 1].bottom() - rung_top < ladder_gap) {
+          ++rung;
+          rung_top = std::max(rung_top, cell_blocks[rung].height);
+        }
+        if (rung + 1 - first >= ladder_blocks) {
+          last = rung;
+          top = rung_top;
+        }
+      }
       while (last + 1 < cell_blocks.size() && cell_blocks[last + 1].bottom() - top < stack_gap) {
         ++last;
         top = std::max(top, cell_blocks[last].height);

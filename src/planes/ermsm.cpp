@@ -252,7 +252,13 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   for (std::size_t n = 0; n < map.cellCount(); ++n) {
     for (Block& block : map.mutableBlocksAt(n)) block.plane = 0;
   }
-  const BlockGrid grid(map, BlockGridConfig{config.stack_gap, 5.0 * config.noise});
+  // A level rung is fused from a few points (under ten): its variance is a good part
+  // of one point's σ², a table top's far below it.
+  const BlockGrid grid(map, BlockGridConfig{.stack_gap = config.stack_gap,
+                                            .level_band = 5.0 * config.noise,
+                                            .ladder_gap = config.ladder_gap,
+                                            .ladder_blocks = config.ladder_blocks,
+                                            .rung_variance = 0.1 * config.noise * config.noise});
   DirectionConfig direction_config;
   direction_config.radius = config.radius;
   direction_config.height_tolerance = static_cast<float>(config.epsilon);

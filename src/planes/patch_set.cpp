@@ -136,10 +136,12 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
       const Plane& first = planes[a];
       const Plane& second = planes[b];
       if (std::abs(first.normal.dot(second.normal)) < cos_parallel) continue;
-      if (std::abs(first.normal.dot(second.centroid) + first.offset) >= epsilon ||
-          std::abs(second.normal.dot(first.centroid) + second.offset) >= epsilon) {
-        continue;
-      }
+      // The smaller piece lies on the larger one's plane: its own fit is the less sure
+      // (a few blocks' tilt puts the far centroid of a long wall well off it).
+      const bool first_larger = set.blocks[a].size() >= set.blocks[b].size();
+      const Plane& larger = first_larger ? first : second;
+      const Plane& smaller = first_larger ? second : first;
+      if (std::abs(larger.normal.dot(smaller.centroid) + larger.offset) >= epsilon) continue;
       if (boxes[a].min_i - touch_radius > boxes[b].max_i || boxes[b].min_i - touch_radius > boxes[a].max_i ||
           boxes[a].min_j - touch_radius > boxes[b].max_j || boxes[b].min_j - touch_radius > boxes[a].max_j) {
         continue;

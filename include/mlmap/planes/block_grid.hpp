@@ -35,6 +35,14 @@ struct PlaneBlock {
 struct BlockGridConfig {
   double stack_gap = 0.0;   // m, consecutive blocks of a cell closer than this are one eRMSM block
   double level_band = 0.0;  // m, a block (or stack) no deeper than this is level; at least the cell size
+  // A surface seen at a grazing angle, or far away, is sampled by scan lines further
+  // apart than the stack gap: its cell column holds a ladder of short blocks. A run of
+  // at least `ladder_blocks` blocks, each shorter than `ladder_gap` and less than
+  // `ladder_gap` apart, is one block too (two or three blocks that far apart are
+  // more likely separate objects, a shelf, a seat).
+  double ladder_gap = 0.0;  // m; 0 = no ladders
+  int ladder_blocks = 4;
+  double rung_variance = 0.0;  // m², a level rung's variance exceeds this (fused from few points)
 };
 
 class BlockGrid {

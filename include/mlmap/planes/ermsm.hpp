@@ -20,6 +20,11 @@ struct ErmsmConfig {
   // between scan lines in cells finer than their spacing); a stack no deeper than
   // max(cell size, 5 σ) counts as level.
   double stack_gap = 0.06;
+  // m: a ladder of at least ladder_blocks short blocks of a cell, each less than this
+  // apart, is one eRMSM block too (a surface seen at a grazing angle or far away,
+  // its scan lines further apart than the stack gap); 0 = no ladders.
+  double ladder_gap = 0.2;
+  int ladder_blocks = 6;
   double kappa_deg = 25.0;        // deg, max angle between a block's direction and the plane, κ
   double theta_deg = 15.0;        // deg, max angle between the three seeds' directions, θ
   double min_probability = 0.99;  // p_t of eq. 10's acceptance test
