@@ -1,14 +1,17 @@
 // The CLI from a labelled map to every export, and merge: with a transform, by
-// registration, and refused when the maps do not overlap.
+// registration, and refused when the maps do not overlap; label, point by point.
 #include <doctest/doctest.h>
 
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
 #include "helpers.hpp"
 #include "json_schema.hpp"
 #include "mlmap/io/map_file.hpp"
+#include "mlmap/io/tum_poses.hpp"
+#include "mlmap/io/xyz.hpp"
 #include "room_scenes.hpp"
 
 using mlmap::test::runCli;
@@ -117,4 +120,71 @@ TEST_CASE("CLI: merge with a transform, by registration, and refused without ove
                   (rooms.dir / "bad.txt").string() + " -o " + refused.string());
   CHECK(result.exit_code == 1);
   CHECK(result.output.find("bad.txt:1") != std::string::npos);
+}
+
+namespace {
+
+// Of the points with a patch, the share whose true plane is the one most of their
+// patch's points lie on: 1 when every patch holds points of one surface only.
+double labelPurity(const std::vector<std::int32_t>& predicted, const std::vector<std::int32_t>& truth) {
+  std::map<std::int32_t, std::map<std::int32_t, std::size_t>> counts;  // patch -> true plane -> points
+  for (std::size_t k = 0; k < predicted.size(); ++k)
+    if (predicted[k] > 0) ++counts[predicted[k]][truth[k]];
+  std::size_t majority = 0;
+  std::size_t total = 0;
+  for (const auto& [patch, by_truth] : counts) {
+    std::size_t best = 0;
+    for (const auto& [plane, count] : by_truth) {
+      best = std::max(best, count);
+      total += count;
+    }
+    majority += best;
+  }
+  return total == 0 ? 0.0 : static_cast<double>(majority) / static_cast<double>(total);
+}
+
+}  // namespace
+
+TEST_CASE("CLI: label writes every scan point in order with its patch, refined on the patches' planes") {
+  RoomMaps rooms;
+  const fs::path labelled = rooms.dir / "labelled.mlmap";
+  auto result = runCli("--quiet planes " + rooms.map.string() + " -o " + labelled.string());
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  std::string scans;
+  std::vector<std::int32_t> truth;
+  std::vector<mlmap::Scan> inputs;
+  for (int k = 0; k < 4; ++k) {
+    const fs::path scan = rooms.dir / "sim" / ("scan_00" + std::to_string(k) + ".xyz");
+    scans.append(" ").append(scan.string());  // (" " + string trips g++ 12's -Wrestrict)
+    inputs.push_back(mlmap::io::readXyz(scan));
+    truth.insert(truth.end(), inputs.back().labels.begin(), inputs.back().labels.end());
+  }
+  const std::string poses = (rooms.dir / "sim" / "poses_true.txt").string();
+  const fs::path refined = rooms.dir / "refined.xyz";
+  const fs::path by_block = rooms.dir / "blocks.xyz";
+  result = runCli("--quiet label " + labelled.string() + " --poses " + poses + " -o " + refined.string() + scans);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  result = runCli("--quiet label --block-labels " + labelled.string() + " --poses " + poses + " -o " +
+                  by_block.string() + scans);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+
+  const mlmap::Scan points = mlmap::io::readXyz(refined);
+  const mlmap::Scan block_points = mlmap::io::readXyz(by_block);
+  REQUIRE(points.size() == truth.size());
+  REQUIRE(block_points.size() == truth.size());
+  // Input order, world frame: the first scan's first point, moved by its true pose.
+  const mlmap::Point first = mlmap::io::readTumPoses(poses).at(0).pose * inputs[0].points[0];
+  CHECK((points.points[0] - first).norm() < 1e-4);
+  const auto patches = mlmap::io::readMap(labelled).planes()->planes.size();
+  std::size_t with_patch = 0;
+  for (const std::int32_t label : points.labels) {
+    CHECK((label == -1 || (label >= 1 && static_cast<std::size_t>(label) <= patches)));
+    with_patch += label > 0 ? 1 : 0;
+  }
+  CHECK(static_cast<double>(with_patch) > 0.9 * static_cast<double>(points.size()));
+  // Edge blocks hold points of two surfaces; the refinement gives them back.
+  const double purity = labelPurity(points.labels, truth);
+  const double block_purity = labelPurity(block_points.labels, truth);
+  CHECK(purity > 0.995);
+  CHECK(purity > block_purity);
 }
