@@ -9,7 +9,7 @@ For every scene: simulate it (true poses, 1 cm range noise), and for every cell 
 the block layer, detect planes, label every point and score the labels with
 ../shared/peers/score.py (patch P/R/F1 at IoU >= 0.5, Hoover at 80 %, mean normal error;
 ground-truth planes of fewer than 1000 points are left out, as sub-resolution faces such as
-a table top's 4 cm rim). Also: candidates eRMSM generated before each acceptance beside
+a table top's 4 cm rim; 100 in the -sparse scenes, which have a tenth of the points). Also: candidates eRMSM generated before each acceptance beside
 eq. 7's count for eRANSAC on the same plane (p_t = 0.99). With --peers, the peers run on the
 same world-frame points and the table gives their time and F1 as ratios to mlmap's
 (end to end: map build + detection). Needs python3-numpy.
@@ -25,9 +25,9 @@ def run(cmd, **kw):
     return subprocess.run(cmd, check=True, capture_output=True, text=True, **kw)
 
 
-def score(gt_xyz, labels, planes_true, pred_json=None):
+def score(gt_xyz, labels, planes_true, pred_json=None, min_gt_points=1000):
     cmd = ["/usr/bin/python3", os.path.join(SHARED_PEERS, "score.py"), gt_xyz, labels,
-           "--gt-planes", planes_true, "--min-gt-points", "1000"]
+           "--gt-planes", planes_true, "--min-gt-points", str(min_gt_points)]
     if pred_json:
         cmd += ["--pred-json", pred_json]
     return json.loads(run(cmd).stdout)
@@ -43,8 +43,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--peers", help="build directory of ../shared/peers (cgal_ransac, pcl_sac, ...)")
-    ap.add_argument("--scenes", default="lab,corridor")
-    ap.add_argument("--cells", default="lab:0.02,0.05,0.1;corridor:0.05,0.1")
+    ap.add_argument("--scenes", default="lab,corridor,lab-sparse",
+                    help="scenes of maps/; NAME-sparse is NAME scanned 5x more coarsely (tilt step 2 deg, 0.5 deg per beam)")
+    ap.add_argument("--cells", default="lab:0.02,0.05,0.1;corridor:0.05,0.1;lab-sparse:0.05")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench"))
     a = ap.parse_args()
     if not os.path.exists(os.path.join(SHARED_PEERS, "score.py")):
@@ -54,7 +55,18 @@ def main():
     rows, eq7 = [], []
     for scene in a.scenes.split(","):
         sim = os.path.join(a.out, scene)
-        run([mlmap, "-q", "simulate", os.path.join(ROOT, "maps", scene + ".json"), "-o", sim])
+        scene_json = os.path.join(ROOT, "maps", scene + ".json")
+        if scene.endswith("-sparse"):
+            # Scan lines 2 deg apart (17 cm at 5 m): the surfaces a robot sees from afar.
+            description = json.load(open(os.path.join(ROOT, "maps", scene[:-len("-sparse")] + ".json")))
+            description["scan_pattern"].update(tilt_step_deg=2.0, angular_step_deg=0.5)
+            os.makedirs(a.out, exist_ok=True)
+            scene_json = os.path.join(a.out, scene + ".json")
+            json.dump(description, open(scene_json, "w"))
+        run([mlmap, "-q", "simulate", scene_json, "-o", sim])
+        # A sparse scene has a tenth of the points (a fifth of the lines, half the beams):
+        # a tenth of the threshold leaves out the same sub-resolution faces.
+        min_gt = 100 if scene.endswith("-sparse") else 1000
         scans = sorted(os.path.join(sim, f) for f in os.listdir(sim) if f.startswith("scan_"))
         poses = os.path.join(sim, "poses_true.txt")
         gt = os.path.join(sim, "all_world.xyz")
@@ -71,7 +83,7 @@ def main():
             run([mlmap, "-q", "planes", m, "--json", pj, "-o", ml])
             run([mlmap, "-q", "label", ml, "--poses", poses, "-o", lab] + scans)
             J = json.load(open(pj))
-            s = score(gt, lab, planes_true)
+            s = score(gt, lab, planes_true, min_gt_points=min_gt)
             rows.append(dict(tag=tag, points=npoints, blocks=J["map"]["blocks"], planes=len(J["planes"]),
                              candidates=J["detection"]["candidates"], detect_s=J["timings"]["total_s"],
                              build_s=build_s, **{k: s[k] for k in ("precision", "recall", "f1", "mean_normal_error_deg")},
@@ -95,7 +107,7 @@ def main():
                     continue
                 name = f[:-len(".score.json")]
                 # The peers' score is recomputed with the same rule as mlmap's.
-                s = score(gt, os.path.join(pout, name + ".labels"), planes_true)
+                s = score(gt, os.path.join(pout, name + ".labels"), planes_true, min_gt_points=min_gt)
                 r = json.load(open(os.path.join(pout, name + ".json")))
                 mine = best["build_s"] + best["detect_s"]
                 print(f"  {scene}: {name}: {r['seconds']['total']:.2f} s, F1 {s['f1']:.3f} | mlmap ({best['tag']}) "
