@@ -187,6 +187,7 @@ bool Detector::accept(std::size_t index) {
 }
 
 PatchSet Detector::run(ErmsmStats& stats) {
+  const auto start = Clock::now();
   stats_ = &stats;
   const int batch = std::max(1, config_.batch_size);
 #ifdef _OPENMP
@@ -227,22 +228,35 @@ PatchSet Detector::run(ErmsmStats& stats) {
     // unlikely to have been overlooked.
     while (const auto best = bestCandidate()) {
       if (acceptanceProbability(candidates_[*best]) < config_.min_probability) break;
+      const auto accept_start = Clock::now();
       accept(*best);
+      stats.stages.patches += secondsSince(accept_start);
       if (seedable_.size() - seedable_taken_ < 3) break;
     }
   }
   stats.accepted = static_cast<std::size_t>(accepted_);
+  stats.stages.search = secondsSince(start) - stats.stages.patches;
+  const auto merge_start = Clock::now();
   // Block points sit at cell centres: pieces of one surface lie up to half a cell
   // further apart than ε allows a block.
   mergeCoplanar(grid_, patches_, config_.epsilon + 0.5 * grid_.cellSize(), radians(config_.kappa_deg));
+  stats.stages.merges = secondsSince(merge_start);
   return std::move(patches_);
 }
 
 }  // namespace
 
 PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
-  auto start = Clock::now();
+  const auto start = Clock::now();
+  auto stage_start = start;
   PlaneDetection detection;
+  ErmsmStats& stats = detection.stats;
+  // Seconds since the last call: the stage that just ended.
+  auto stage = [&stage_start] {
+    const double seconds = secondsSince(stage_start);
+    stage_start = Clock::now();
+    return seconds;
+  };
   ErmsmConfig& config = detection.config;
   config = input_config;
   if (config.noise <= 0.0) config.noise = rangeNoise(map);
@@ -252,23 +266,28 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   for (std::size_t n = 0; n < map.cellCount(); ++n) {
     for (Block& block : map.mutableBlocksAt(n)) block.plane = 0;
   }
+  stats.stages.noise = stage();
   const BlockGrid grid(map, BlockGridConfig{config.stack_gap, 5.0 * config.noise});
+  stats.stages.grid = stage();
   DirectionConfig direction_config;
   direction_config.radius = config.radius;
   direction_config.height_tolerance = static_cast<float>(config.epsilon);
   direction_config.threads = config.threads;
   const std::vector<Eigen::Vector3f> directions = directionVectors(grid, direction_config);
-  ErmsmStats& stats = detection.stats;
+  stats.stages.directions = stage();
   stats.direction_seconds = secondsSince(start);
   stats.blocks = grid.size();
   stats.blocks_with_direction = static_cast<std::size_t>(
       std::count_if(directions.begin(), directions.end(), [](const Eigen::Vector3f& d) { return d.squaredNorm() > 0.0F; }));
 
-  start = Clock::now();
+  const auto detection_start = Clock::now();
   Detector detector(grid, directions, config);
+  stats.stages.index = stage();
   PatchSet patches = detector.run(stats);
+  stage();
   classifyPlanes(patches.planes);
   mergeLevels(grid, patches, radians(config.kappa_deg));
+  stats.stages.merges += stage();
   detection.planes = std::move(patches.planes);
   for (std::size_t n = 0; n < map.cellCount(); ++n) {
     const auto blocks = map.mutableBlocksAt(n);
@@ -280,8 +299,9 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
       }
     }
   }
+  stats.stages.labels = stage();
   // Everything after the direction vectors, the labels written back included.
-  stats.detection_seconds = secondsSince(start);
+  stats.detection_seconds = secondsSince(detection_start);
   return detection;
 }
 
