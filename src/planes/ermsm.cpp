@@ -57,10 +57,10 @@ class Detector {
       : grid_(grid),
         directions_(directions),
         config_(config),
-        scorer_(grid, directions, config.epsilon, radians(config.kappa_deg)),
+        scorer_(grid, directions, config.epsilon, radians(config.kappa_deg), config.threads),
         min_score_(config.min_area / (grid.cellSize() * grid.cellSize())) {
     patches_.labels.assign(grid.size(), 0);
-    for (std::uint32_t id = 0; id < grid_.size(); ++id) {
+    for (const std::uint32_t id : grid_.idsInMapOrder()) {
       if (directions_[id].squaredNorm() > 0.0F) seedable_.push_back(id);
     }
   }
@@ -84,7 +84,7 @@ class Detector {
   const ErmsmConfig& config_;
   PlaneScorer scorer_;
   double min_score_;
-  std::vector<std::uint32_t> seedable_;  // blocks with a direction vector, taken ones pruned now and then
+  std::vector<std::uint32_t> seedable_;  // blocks with a direction vector, in map order; taken ones pruned now and then
   std::size_t seedable_taken_ = 0;       // of which taken
   std::vector<Candidate> candidates_;    // L_c
   std::size_t unlisted_ = 0;             // drawn candidates too small to ever be accepted
@@ -289,8 +289,8 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   mergeLevels(grid, patches, radians(config.kappa_deg));
   stats.stages.merges += stage();
   detection.planes = std::move(patches.planes);
-  for (std::size_t n = 0; n < map.cellCount(); ++n) {
-    const auto blocks = map.mutableBlocksAt(n);
+  for (std::size_t n = 0; n < grid.cellCount(); ++n) {
+    const auto blocks = map.mutableBlocksAt(grid.mapCellOf(n));
     for (std::uint32_t id = grid.firstBlockOfCell(n); id < grid.firstBlockOfCell(n + 1); ++id) {
       const PlaneBlock& block = grid.blocks()[id];
       for (std::size_t k = block.map_first; k < block.map_first + block.map_count; ++k) {

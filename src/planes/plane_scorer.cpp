@@ -6,7 +6,10 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
-#include <tuple>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace mlmap {
 namespace {
@@ -39,6 +42,30 @@ const BinLayout& binLayout() {
 }
 
 int binCount() { return binLayout().first[kElevationRows]; }
+
+// Stably reorders the ids by key(id): a counting sort over the keys' range, or a stable
+// comparison sort when that range is far wider than the list (a map kilometres long).
+template <typename Key>
+void stableSortBy(std::vector<std::uint32_t>& ids, Key key) {
+  if (ids.empty()) return;
+  std::int64_t low = key(ids[0]);
+  std::int64_t high = low;
+  for (const std::uint32_t id : ids) {
+    low = std::min<std::int64_t>(low, key(id));
+    high = std::max<std::int64_t>(high, key(id));
+  }
+  const auto range = static_cast<std::size_t>(high - low + 1);
+  if (range > 4 * ids.size() + 4096) {
+    std::stable_sort(ids.begin(), ids.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+    return;
+  }
+  std::vector<std::uint32_t> first(range + 1, 0);
+  for (const std::uint32_t id : ids) ++first[static_cast<std::size_t>(key(id) - low) + 1];
+  for (std::size_t k = 1; k <= range; ++k) first[k] += first[k - 1];
+  std::vector<std::uint32_t> sorted(ids.size());
+  for (const std::uint32_t id : ids) sorted[first[static_cast<std::size_t>(key(id) - low)]++] = id;
+  ids = std::move(sorted);
+}
 
 int binOf(const Eigen::Vector3f& direction) {
   // Unsigned axes: use the upper hemisphere's representative.
@@ -82,7 +109,7 @@ struct PlaneScorer::Query {
 };
 
 PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
-                         double epsilon, double kappa_rad)
+                         double epsilon, double kappa_rad, int threads)
     : grid_(grid),
       directions_(directions),
       epsilon_(static_cast<float>(epsilon)),
@@ -93,13 +120,21 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   // Each bin's axis: the mean of its members' directions (so a bin of wall blocks,
   // whose directions are level, has a level axis), and a frame across it.
   std::vector<std::int32_t> bin_of(grid.size(), -1);
+  const auto count = static_cast<std::int64_t>(grid.size());
+#ifdef _OPENMP
+  const int team = threads > 0 ? threads : omp_get_max_threads();
+#endif
+#pragma omp parallel for schedule(static) num_threads(team)
+  for (std::int64_t id = 0; id < count; ++id) {
+    const Eigen::Vector3f& d = directions[static_cast<std::size_t>(id)];
+    if (d.squaredNorm() > 0.0F) bin_of[static_cast<std::size_t>(id)] = binOf(d);
+  }
   std::vector<Eigen::Vector3f> sums(bins, Eigen::Vector3f::Zero());
   std::vector<Eigen::Vector3f> first(bins, Eigen::Vector3f::Zero());
   for (std::uint32_t id = 0; id < grid.size(); ++id) {
+    const int bin = bin_of[id];
+    if (bin < 0) continue;
     const Eigen::Vector3f& d = directions[id];
-    if (d.squaredNorm() == 0.0F) continue;
-    const int bin = binOf(d);
-    bin_of[id] = bin;
     Eigen::Vector3f& reference = first[static_cast<std::size_t>(bin)];
     if (reference.squaredNorm() == 0.0F) reference = d;
     sums[static_cast<std::size_t>(bin)] += d.dot(reference) < 0.0F ? Eigen::Vector3f(-d) : d;
@@ -114,23 +149,43 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   }
   const double layer_size = 0.5 * epsilon;
   const double tile_size = kTileCells * grid.cellSize();
-  using Key = std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int32_t, std::uint32_t>;
-  std::vector<Key> keys;
+  // Each block's place in the index: its bin, its layer in the bin, its tile in the layer.
+  struct Place {
+    std::int32_t bin, layer, tile_u, tile_v;
+  };
+  std::vector<Place> places(grid.size());
+  std::vector<std::uint32_t> order;
   for (std::uint32_t id = 0; id < grid.size(); ++id) {
     if (bin_of[id] < 0) continue;
     const Frame& frame = frames_[static_cast<std::size_t>(bin_of[id])];
     const Eigen::Vector3f& p = grid.blocks()[id].point;
-    keys.emplace_back(bin_of[id], static_cast<std::int32_t>(std::floor(frame.a.dot(p) / layer_size)),
-                      static_cast<std::int32_t>(std::floor(frame.u.dot(p) / tile_size)),
-                      static_cast<std::int32_t>(std::floor(frame.v.dot(p) / tile_size)), id);
+    places[id] = {bin_of[id], static_cast<std::int32_t>(std::floor(frame.a.dot(p) / layer_size)),
+                  static_cast<std::int32_t>(std::floor(frame.u.dot(p) / tile_size)),
+                  static_cast<std::int32_t>(std::floor(frame.v.dot(p) / tile_size))};
+    order.push_back(id);
   }
-  std::sort(keys.begin(), keys.end());
+  // Ordered by (bin, layer, tile), ids ascending within a tile: stable sorts from the
+  // least significant key (a comparison sort of the 5-tuples cost far more).
+  stableSortBy(order, [&](std::uint32_t id) { return places[id].tile_v; });
+  stableSortBy(order, [&](std::uint32_t id) { return places[id].tile_u; });
+  stableSortBy(order, [&](std::uint32_t id) { return places[id].layer; });
+  stableSortBy(order, [&](std::uint32_t id) { return places[id].bin; });
   bins_.resize(bins);
-  for (std::size_t k = 0; k < keys.size(); ++k) {
-    const auto [bin, layer, tu, tv, id] = keys[k];
-    const bool new_bin = k == 0 || std::get<0>(keys[k - 1]) != bin;
-    const bool new_layer = new_bin || std::get<1>(keys[k - 1]) != layer;
-    const bool new_tile = new_layer || std::get<2>(keys[k - 1]) != tu || std::get<3>(keys[k - 1]) != tv;
+  ids_.reserve(order.size());
+  points_.reserve(order.size());
+  block_directions_.reserve(order.size());
+  surfaces_.reserve(order.size());
+  half_depths_.reserve(order.size());
+  order_taken_.reserve(order.size());
+  tile_of_.reserve(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const std::uint32_t id = order[k];
+    const Place& place = places[id];
+    const Place* previous = k == 0 ? nullptr : &places[order[k - 1]];
+    const auto bin = place.bin;
+    const bool new_bin = previous == nullptr || previous->bin != bin;
+    const bool new_layer = new_bin || previous->layer != place.layer;
+    const bool new_tile = new_layer || previous->tile_u != place.tile_u || previous->tile_v != place.tile_v;
     if (new_bin) bins_[static_cast<std::size_t>(bin)].begin = static_cast<std::uint32_t>(layers_.size());
     if (new_layer) {
       layers_.emplace_back();

@@ -35,8 +35,9 @@ struct PlaneScore {
 
 class PlaneScorer {
  public:
+  // `threads`: OpenMP threads for building the index, 0 = OpenMP's default.
   PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
-              double epsilon, double kappa_rad);
+              double epsilon, double kappa_rad, int threads = 0);
 
   PlaneScore score(const CandidatePlane& plane) const;
   // Ids of the untaken blocks matching the plane, ascending.
