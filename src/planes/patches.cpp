@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
 #include <numeric>
+
+#include "counting_sort.hpp"
 
 namespace mlmap {
 namespace {
@@ -28,6 +29,59 @@ class DisjointSets {
   std::vector<std::size_t> parent_;
 };
 
+// A block's footprint on the plane's raster: raster cells (u, v) with v in [v_low, v_high].
+struct Segment {
+  std::int32_t u;
+  std::int32_t v_low;
+  std::int32_t v_high;
+};
+
+// The footprints of the blocks on a raster of cell_size along the plane basis from
+// `point`: raster cell (u, v) covers [u, u + 1) × [v, v + 1) cells. A horizontal block
+// covers the cell of its point, a vertical block every cell its extent crosses: with u
+// level (any plane but a near-horizontal one) that is one run of v at the u of its
+// point, else the cells of points along its extent a cell apart. Block k's segments are
+// [first_of_block[k], first_of_block[k + 1]), the one of its point first.
+struct Footprints {
+  std::vector<Segment> segments;
+  std::vector<std::size_t> first_of_block;
+
+  Footprints(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& u_axis,
+             const Eigen::Vector3d& v_axis, const Eigen::Vector3d& point) {
+    const double cell = grid.cellSize();
+    auto cellOf = [&](const Eigen::Vector3d& p) {
+      const Eigen::Vector3d relative = p - point;
+      return Eigen::Vector2i(static_cast<std::int32_t>(std::floor(relative.dot(u_axis) / cell)),
+                             static_cast<std::int32_t>(std::floor(relative.dot(v_axis) / cell)));
+    };
+    // planeBasis makes u = z × n: level exactly, so a vertical block keeps one u.
+    const bool level_u = u_axis.z() == 0.0;
+    segments.reserve(blocks.size());
+    first_of_block.resize(blocks.size() + 1);
+    for (std::size_t k = 0; k < blocks.size(); ++k) {
+      first_of_block[k] = segments.size();
+      const PlaneBlock& block = grid.blocks()[blocks[k]];
+      const Eigen::Vector3d centre = block.point.cast<double>();
+      const Eigen::Vector2i centre_cell = cellOf(centre);
+      segments.push_back({centre_cell.x(), centre_cell.y(), centre_cell.y()});
+      if (!block.vertical) continue;
+      const double depth = block.top - block.bottom;
+      const int steps = std::max(1, static_cast<int>(std::ceil(depth / cell)));
+      auto sample = [&](int s) { return cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.bottom + depth * s / steps)); };
+      if (level_u) {
+        // v grows with height (v_z ≥ 0) by at most a cell per step: one run.
+        segments.push_back({centre_cell.x(), sample(0).y(), sample(steps).y()});
+      } else {
+        for (int s = 0; s <= steps; ++s) {
+          const Eigen::Vector2i c = sample(s);
+          segments.push_back({c.x(), c.y(), c.y()});
+        }
+      }
+    }
+    first_of_block[blocks.size()] = segments.size();
+  }
+};
+
 // Blocks rasterised on a grid of cell_size in the plane: a dense raster over their
 // bounding box with a margin (planes in a building are compact, and lookups in an
 // array beat a hash map by far). Raster cell (u, v) covers [u, u + 1) × [v, v + 1) cells
@@ -47,30 +101,18 @@ struct PlaneRaster {
     return slots[static_cast<std::size_t>((v - min_v + margin) * columns + (u - min_u + margin))];
   }
 
-  PlaneRaster(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& u_axis,
-              const Eigen::Vector3d& v_axis, const Eigen::Vector3d& point, int margin_cells)
-      : margin(margin_cells) {
-    const double cell = grid.cellSize();
+  PlaneRaster(const Footprints& footprints, int margin_cells) : margin(margin_cells) {
     std::vector<Eigen::Vector2i> raw;
-    first_of_block.resize(blocks.size() + 1);
-    auto cellOf = [&](const Eigen::Vector3d& p) {
-      const Eigen::Vector3d relative = p - point;
-      return Eigen::Vector2i(static_cast<std::int32_t>(std::floor(relative.dot(u_axis) / cell)),
-                             static_cast<std::int32_t>(std::floor(relative.dot(v_axis) / cell)));
-    };
-    for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const std::size_t block_count = footprints.first_of_block.size() - 1;
+    first_of_block.resize(block_count + 1);
+    for (std::size_t k = 0; k < block_count; ++k) {
       first_of_block[k] = raw.size();
-      const PlaneBlock& block = grid.blocks()[blocks[k]];
-      const Eigen::Vector3d centre = block.point.cast<double>();
-      raw.push_back(cellOf(centre));
-      if (!block.vertical) continue;
-      const double depth = block.top - block.bottom;
-      const int steps = std::max(1, static_cast<int>(std::ceil(depth / cell)));
-      for (int s = 0; s <= steps; ++s) {
-        raw.push_back(cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.bottom + depth * s / steps)));
+      for (std::size_t n = footprints.first_of_block[k]; n < footprints.first_of_block[k + 1]; ++n) {
+        const Segment& segment = footprints.segments[n];
+        for (std::int32_t v = segment.v_low; v <= segment.v_high; ++v) raw.emplace_back(segment.u, v);
       }
     }
-    first_of_block[blocks.size()] = raw.size();
+    first_of_block[block_count] = raw.size();
     if (raw.empty()) return;
     min_u = raw[0].x();
     min_v = raw[0].y();
@@ -185,28 +227,68 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;
   planeBasis(normal, u_axis, v_axis);
-  PlaneRaster raster(grid, blocks, u_axis, v_axis, point, gap_cells);
-  DisjointSets sets(raster.cells.size());
-  for (std::size_t n = 0; n < raster.cells.size(); ++n) {
-    // Half the neighbourhood suffices: the other half links back to this cell.
-    for (int dv = 0; dv <= gap_cells; ++dv) {
-      for (int du = -gap_cells; du <= gap_cells; ++du) {
-        if (dv == 0 && du <= 0) continue;
-        const std::int32_t other = raster.at(raster.cells[n].x() + du, raster.cells[n].y() + dv);
-        if (other >= 0) sets.unite(n, static_cast<std::size_t>(other));
+  const Footprints footprints(grid, blocks, u_axis, v_axis, point);
+  const std::vector<Segment>& segments = footprints.segments;
+  // Cells are connected within gap_cells (Chebyshev). Not cell by cell (a wall at 2 cm
+  // rasterises to over half a million cells): in each raster column u, segments less
+  // than gap_cells apart join into runs, and runs of columns up to gap_cells apart
+  // connect when their closest cells are: when neither starts more than gap_cells past
+  // the other's end. (Both runs' ends are occupied, and no cell inside a run is more
+  // than gap_cells / 2 from an occupied one.)
+  struct Numbered {
+    Segment segment;
+    std::uint32_t number;
+  };
+  std::vector<Numbered> order(segments.size());
+  for (std::uint32_t n = 0; n < segments.size(); ++n) order[n] = {segments[n], n};
+  stableSortBy(order, [](const Numbered& item) { return item.segment.v_low; });
+  stableSortBy(order, [](const Numbered& item) { return item.segment.u; });
+  std::vector<Segment> runs;
+  std::vector<std::uint32_t> run_of_segment(segments.size());
+  for (const auto& [segment, n] : order) {
+    if (runs.empty() || runs.back().u != segment.u ||
+        static_cast<std::int64_t>(segment.v_low) - runs.back().v_high > gap_cells) {
+      runs.push_back(segment);
+    } else {
+      runs.back().v_high = std::max(runs.back().v_high, segment.v_high);
+    }
+    run_of_segment[n] = static_cast<std::uint32_t>(runs.size() - 1);
+  }
+  // The runs of each column: [column_first[u − min_u], column_first[u − min_u + 1]).
+  const std::int32_t min_u = runs.front().u;
+  const auto columns = static_cast<std::size_t>(static_cast<std::int64_t>(runs.back().u) - min_u + 1);
+  std::vector<std::uint32_t> column_first(columns + 1, 0);
+  for (const Segment& run : runs) ++column_first[static_cast<std::size_t>(run.u - min_u) + 1];
+  for (std::size_t c = 1; c <= columns; ++c) column_first[c] += column_first[c - 1];
+  DisjointSets sets(runs.size());
+  for (std::size_t column = 0; column < columns; ++column) {
+    for (std::size_t other = column + 1; other <= std::min(columns - 1, column + static_cast<std::size_t>(gap_cells));
+         ++other) {
+      // Both columns' runs are ordered by v and disjoint: one sweep pairs them.
+      std::uint32_t b = column_first[other];
+      for (std::uint32_t a = column_first[column]; a < column_first[column + 1]; ++a) {
+        while (b < column_first[other + 1] && static_cast<std::int64_t>(runs[a].v_low) - runs[b].v_high > gap_cells) ++b;
+        for (std::uint32_t c = b;
+             c < column_first[other + 1] && static_cast<std::int64_t>(runs[c].v_low) - runs[a].v_high <= gap_cells; ++c) {
+          sets.unite(a, c);
+        }
       }
     }
   }
-  // Components keyed by their root; roots are the smallest cell number, so the
-  // order is deterministic.
-  std::map<std::size_t, Patch> by_root;
+  // Patches in the order of their first block (the order of the blocks' first raster
+  // cells), then largest first.
+  std::vector<std::int32_t> patch_of_root(runs.size(), -1);
+  std::vector<Patch> patches;
   for (std::size_t k = 0; k < blocks.size(); ++k) {
-    Patch& patch = by_root[sets.find(raster.block_cells[raster.first_of_block[k]])];
+    const std::size_t root = sets.find(run_of_segment[footprints.first_of_block[k]]);
+    if (patch_of_root[root] < 0) {
+      patch_of_root[root] = static_cast<std::int32_t>(patches.size());
+      patches.emplace_back();
+    }
+    Patch& patch = patches[static_cast<std::size_t>(patch_of_root[root])];
     patch.blocks.push_back(blocks[k]);
     patch.surface += grid.blocks()[blocks[k]].surface;
   }
-  std::vector<Patch> patches;
-  for (auto& [root, patch] : by_root) patches.push_back(std::move(patch));
   std::stable_sort(patches.begin(), patches.end(),
                    [](const Patch& a, const Patch& b) { return a.surface > b.surface; });
   return patches;
@@ -219,7 +301,7 @@ std::vector<Eigen::Vector3d> outlineOf(const BlockGrid& grid, const std::vector<
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;
   planeBasis(normal, u_axis, v_axis);
-  PlaneRaster raster(grid, blocks, u_axis, v_axis, point, 1);
+  PlaneRaster raster(Footprints(grid, blocks, u_axis, v_axis, point), 1);
   const double cell = grid.cellSize();
   for (const Eigen::Vector2i& corner : outerBoundary(raster, [](std::size_t) { return true; })) {
     outline.push_back(point + u_axis * (corner.x() * cell) + v_axis * (corner.y() * cell));

@@ -7,6 +7,9 @@
 #include <limits>
 #include <numbers>
 
+#include "counting_sort.hpp"
+#include "id_set.hpp"
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -42,30 +45,6 @@ const BinLayout& binLayout() {
 }
 
 int binCount() { return binLayout().first[kElevationRows]; }
-
-// Stably reorders the ids by key(id): a counting sort over the keys' range, or a stable
-// comparison sort when that range is far wider than the list (a map kilometres long).
-template <typename Key>
-void stableSortBy(std::vector<std::uint32_t>& ids, Key key) {
-  if (ids.empty()) return;
-  std::int64_t low = key(ids[0]);
-  std::int64_t high = low;
-  for (const std::uint32_t id : ids) {
-    low = std::min<std::int64_t>(low, key(id));
-    high = std::max<std::int64_t>(high, key(id));
-  }
-  const auto range = static_cast<std::size_t>(high - low + 1);
-  if (range > 4 * ids.size() + 4096) {
-    std::stable_sort(ids.begin(), ids.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
-    return;
-  }
-  std::vector<std::uint32_t> first(range + 1, 0);
-  for (const std::uint32_t id : ids) ++first[static_cast<std::size_t>(key(id) - low) + 1];
-  for (std::size_t k = 1; k <= range; ++k) first[k] += first[k - 1];
-  std::vector<std::uint32_t> sorted(ids.size());
-  for (const std::uint32_t id : ids) sorted[first[static_cast<std::size_t>(key(id) - low)]++] = id;
-  ids = std::move(sorted);
-}
 
 int binOf(const Eigen::Vector3f& direction) {
   // Unsigned axes: use the upper hemisphere's representative.
@@ -152,24 +131,23 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   // Each block's place in the index: its bin, its layer in the bin, its tile in the layer.
   struct Place {
     std::int32_t bin, layer, tile_u, tile_v;
+    std::uint32_t id;
   };
-  std::vector<Place> places(grid.size());
-  std::vector<std::uint32_t> order;
+  std::vector<Place> order;
   for (std::uint32_t id = 0; id < grid.size(); ++id) {
     if (bin_of[id] < 0) continue;
     const Frame& frame = frames_[static_cast<std::size_t>(bin_of[id])];
     const Eigen::Vector3f& p = grid.blocks()[id].point;
-    places[id] = {bin_of[id], static_cast<std::int32_t>(std::floor(frame.a.dot(p) / layer_size)),
-                  static_cast<std::int32_t>(std::floor(frame.u.dot(p) / tile_size)),
-                  static_cast<std::int32_t>(std::floor(frame.v.dot(p) / tile_size))};
-    order.push_back(id);
+    order.push_back({bin_of[id], static_cast<std::int32_t>(std::floor(frame.a.dot(p) / layer_size)),
+                     static_cast<std::int32_t>(std::floor(frame.u.dot(p) / tile_size)),
+                     static_cast<std::int32_t>(std::floor(frame.v.dot(p) / tile_size)), id});
   }
   // Ordered by (bin, layer, tile), ids ascending within a tile: stable sorts from the
   // least significant key (a comparison sort of the 5-tuples cost far more).
-  stableSortBy(order, [&](std::uint32_t id) { return places[id].tile_v; });
-  stableSortBy(order, [&](std::uint32_t id) { return places[id].tile_u; });
-  stableSortBy(order, [&](std::uint32_t id) { return places[id].layer; });
-  stableSortBy(order, [&](std::uint32_t id) { return places[id].bin; });
+  stableSortBy(order, [](const Place& place) { return place.tile_v; });
+  stableSortBy(order, [](const Place& place) { return place.tile_u; });
+  stableSortBy(order, [](const Place& place) { return place.layer; });
+  stableSortBy(order, [](const Place& place) { return place.bin; });
   bins_.resize(bins);
   ids_.reserve(order.size());
   points_.reserve(order.size());
@@ -179,9 +157,9 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   order_taken_.reserve(order.size());
   tile_of_.reserve(order.size());
   for (std::size_t k = 0; k < order.size(); ++k) {
-    const std::uint32_t id = order[k];
-    const Place& place = places[id];
-    const Place* previous = k == 0 ? nullptr : &places[order[k - 1]];
+    const Place& place = order[k];
+    const std::uint32_t id = place.id;
+    const Place* previous = k == 0 ? nullptr : &order[k - 1];
     const auto bin = place.bin;
     const bool new_bin = previous == nullptr || previous->bin != bin;
     const bool new_layer = new_bin || previous->layer != place.layer;
@@ -380,7 +358,7 @@ bool PlaneScorer::matches(std::uint32_t id, const CandidatePlane& plane) const {
 }
 
 std::vector<std::uint32_t> PlaneScorer::matching(const CandidatePlane& plane) const {
-  std::vector<std::uint32_t> ids;
+  IdSet ids(grid_.size());
   const Query query{plane.normal, -plane.normal.dot(plane.point), cos_kappa_, epsilon_};
   for (std::size_t b = 0; b < bins_.size(); ++b) {
     const Frame& frame = frames_[b];
@@ -399,13 +377,12 @@ std::vector<std::uint32_t> PlaneScorer::matching(const CandidatePlane& plane) co
         for (std::uint32_t k = tile.begin; k < tile.end; ++k) {
           if (order_taken_[k] != 0) continue;
           if (cone == Cone::Cut && std::abs(block_directions_[k].dot(query.normal)) < cos_kappa_) continue;
-          if (std::abs(query.normal.dot(points_[k]) + query.offset) < epsilon_) ids.push_back(ids_[k]);
+          if (std::abs(query.normal.dot(points_[k]) + query.offset) < epsilon_) ids.insert(ids_[k]);
         }
       }
     }
   }
-  std::sort(ids.begin(), ids.end());
-  return ids;
+  return ids.ascending();
 }
 
 void PlaneScorer::take(const std::vector<std::uint32_t>& ids) {
