@@ -183,11 +183,22 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
     std::vector<Eigen::Vector2i> loop;
     std::int32_t edge = static_cast<std::int32_t>(start);
     while (edge >= 0 && used[static_cast<std::size_t>(edge)] == 0) {
-      used[static_cast<std::size_t>(edge)] = 1;
-      loop.push_back(edge_from[static_cast<std::size_t>(edge)]);
-      const Eigen::Vector2i& to = edge_to[static_cast<std::size_t>(edge)];
+      const auto current = static_cast<std::size_t>(edge);
+      used[current] = 1;
+      loop.push_back(edge_from[current]);
+      const Eigen::Vector2i& to = edge_to[current];
+      const Eigen::Vector2i in = to - edge_from[current];
       const auto& next = out[vertexOf(to.x(), to.y())];
-      edge = next[0] >= 0 && used[static_cast<std::size_t>(next[0])] == 0 ? next[0] : next[1];
+      edge = -1;
+      for (const std::int32_t candidate : next) {
+        if (candidate < 0 || used[static_cast<std::size_t>(candidate)] != 0) continue;
+        // Where two cells touch at a corner only, both their sides leave the vertex:
+        // turn right, into the other cell's boundary, so the loop goes round both (the
+        // choice must not depend on the order the cells were listed in).
+        const Eigen::Vector2i out_direction =
+            edge_to[static_cast<std::size_t>(candidate)] - edge_from[static_cast<std::size_t>(candidate)];
+        if (edge < 0 || in.x() * out_direction.y() - in.y() * out_direction.x() < 0) edge = candidate;
+      }
     }
     long twice_area = 0;
     for (std::size_t k = 0; k < loop.size(); ++k) {
@@ -208,6 +219,11 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
     const Eigen::Vector2i b = next_point - best[k];
     if (a.x() * b.y() - a.y() * b.x() != 0) corners.push_back(best[k]);
   }
+  // From the lowest corner (smallest u, then v), whichever edge the loop was found from.
+  const auto lowest = std::min_element(corners.begin(), corners.end(), [](const Eigen::Vector2i& a, const Eigen::Vector2i& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  std::rotate(corners.begin(), lowest, corners.end());
   return corners;
 }
 
