@@ -82,59 +82,69 @@ struct Footprints {
   }
 };
 
-// Blocks rasterised on a grid of cell_size in the plane: a dense raster over their
-// bounding box with a margin (planes in a building are compact, and lookups in an
-// array beat a hash map by far). Raster cell (u, v) covers [u, u + 1) × [v, v + 1) cells
-// along the plane basis from `point`.
+// The footprints merged per raster column: segments of a column whose rows are at most
+// `join_gap` apart join into one run (1: touching or overlapping ones). Runs are ordered
+// by u, then v, and disjoint; run_of_segment names each segment's run.
+struct ColumnRuns {
+  std::vector<Segment> runs;
+  std::vector<std::uint32_t> run_of_segment;
+
+  ColumnRuns(const std::vector<Segment>& segments, int join_gap) : run_of_segment(segments.size()) {
+    struct Numbered {
+      Segment segment;
+      std::uint32_t number;
+    };
+    std::vector<Numbered> order(segments.size());
+    for (std::uint32_t n = 0; n < segments.size(); ++n) order[n] = {segments[n], n};
+    stableSortBy(order, [](const Numbered& item) { return item.segment.v_low; });
+    stableSortBy(order, [](const Numbered& item) { return item.segment.u; });
+    for (const auto& [segment, n] : order) {
+      if (runs.empty() || runs.back().u != segment.u ||
+          static_cast<std::int64_t>(segment.v_low) - runs.back().v_high > join_gap) {
+        runs.push_back(segment);
+      } else {
+        runs.back().v_high = std::max(runs.back().v_high, segment.v_high);
+      }
+      run_of_segment[n] = static_cast<std::uint32_t>(runs.size() - 1);
+    }
+  }
+};
+
+// The occupied raster cells in a dense raster over their bounding box with a margin
+// (planes in a building are compact, and lookups in an array beat a hash map by far).
+// Built from touching runs, so each cell is listed once: the many blocks of a wall's
+// thickness at 2 cm all cover the same cells.
 struct PlaneRaster {
   std::int32_t min_u = 0;
   std::int32_t min_v = 0;
   std::int64_t columns = 0;
   std::int64_t rows = 0;
   int margin = 0;
-  std::vector<std::int32_t> slots;         // per raster cell: its number among the occupied ones, −1 empty
-  std::vector<Eigen::Vector2i> cells;      // occupied cells, in order of first use
-  std::vector<std::size_t> first_of_block; // a block's cells in block_cells: [first_of_block[k], first_of_block[k + 1])
-  std::vector<std::size_t> block_cells;    // occupied-cell numbers
+  std::vector<std::int32_t> slots;     // per raster cell: its number among the occupied ones, −1 empty
+  std::vector<Eigen::Vector2i> cells;  // occupied cells, column by column
 
   std::int32_t& at(std::int64_t u, std::int64_t v) {
     return slots[static_cast<std::size_t>((v - min_v + margin) * columns + (u - min_u + margin))];
   }
 
-  PlaneRaster(const Footprints& footprints, int margin_cells) : margin(margin_cells) {
-    std::vector<Eigen::Vector2i> raw;
-    const std::size_t block_count = footprints.first_of_block.size() - 1;
-    first_of_block.resize(block_count + 1);
-    for (std::size_t k = 0; k < block_count; ++k) {
-      first_of_block[k] = raw.size();
-      for (std::size_t n = footprints.first_of_block[k]; n < footprints.first_of_block[k + 1]; ++n) {
-        const Segment& segment = footprints.segments[n];
-        for (std::int32_t v = segment.v_low; v <= segment.v_high; ++v) raw.emplace_back(segment.u, v);
-      }
-    }
-    first_of_block[block_count] = raw.size();
-    if (raw.empty()) return;
-    min_u = raw[0].x();
-    min_v = raw[0].y();
-    std::int32_t max_u = min_u;
-    std::int32_t max_v = min_v;
-    for (const Eigen::Vector2i& c : raw) {
-      min_u = std::min(min_u, c.x());
-      max_u = std::max(max_u, c.x());
-      min_v = std::min(min_v, c.y());
-      max_v = std::max(max_v, c.y());
+  PlaneRaster(const std::vector<Segment>& runs, int margin_cells) : margin(margin_cells) {
+    if (runs.empty()) return;
+    min_u = runs.front().u;
+    const std::int32_t max_u = runs.back().u;
+    min_v = runs.front().v_low;
+    std::int32_t max_v = runs.front().v_high;
+    for (const Segment& run : runs) {
+      min_v = std::min(min_v, run.v_low);
+      max_v = std::max(max_v, run.v_high);
     }
     columns = static_cast<std::int64_t>(max_u) - min_u + 1 + 2 * margin;
     rows = static_cast<std::int64_t>(max_v) - min_v + 1 + 2 * margin;
     slots.assign(static_cast<std::size_t>(columns * rows), -1);
-    block_cells.resize(raw.size());
-    for (std::size_t n = 0; n < raw.size(); ++n) {
-      std::int32_t& slot = at(raw[n].x(), raw[n].y());
-      if (slot < 0) {
-        slot = static_cast<std::int32_t>(cells.size());
-        cells.push_back(raw[n]);
+    for (const Segment& run : runs) {
+      for (std::int32_t v = run.v_low; v <= run.v_high; ++v) {
+        at(run.u, v) = static_cast<std::int32_t>(cells.size());
+        cells.emplace_back(run.u, v);
       }
-      block_cells[n] = static_cast<std::size_t>(slot);
     }
   }
 };
@@ -176,6 +186,10 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
     if (!occupied(u - 1, v)) addEdge({u, v + 1}, {u, v});
   }
   std::vector<std::uint8_t> used(edge_from.size(), 0);
+  auto before = [](const Eigen::Vector2i& a, const Eigen::Vector2i& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  };
+  auto lowest = [&](const std::vector<Eigen::Vector2i>& loop) { return *std::min_element(loop.begin(), loop.end(), before); };
   std::vector<Eigen::Vector2i> best;
   long best_area = 0;
   for (std::size_t start = 0; start < edge_from.size(); ++start) {
@@ -206,7 +220,8 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
       const auto& b = loop[(k + 1) % loop.size()];
       twice_area += static_cast<long>(a.x()) * b.y() - static_cast<long>(b.x()) * a.y();
     }
-    if (twice_area > best_area) {
+    // Of loops of equal area, the one with the lowest corner: not the one found first.
+    if (twice_area > best_area || (twice_area == best_area && twice_area > 0 && before(lowest(loop), lowest(best)))) {
       best_area = twice_area;
       best = std::move(loop);
     }
@@ -220,10 +235,7 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
     if (a.x() * b.y() - a.y() * b.x() != 0) corners.push_back(best[k]);
   }
   // From the lowest corner (smallest u, then v), whichever edge the loop was found from.
-  const auto lowest = std::min_element(corners.begin(), corners.end(), [](const Eigen::Vector2i& a, const Eigen::Vector2i& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-  });
-  std::rotate(corners.begin(), lowest, corners.end());
+  std::rotate(corners.begin(), std::min_element(corners.begin(), corners.end(), before), corners.end());
   return corners;
 }
 
@@ -251,25 +263,9 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
   // connect when their closest cells are: when neither starts more than gap_cells past
   // the other's end. (Both runs' ends are occupied, and no cell inside a run is more
   // than gap_cells / 2 from an occupied one.)
-  struct Numbered {
-    Segment segment;
-    std::uint32_t number;
-  };
-  std::vector<Numbered> order(segments.size());
-  for (std::uint32_t n = 0; n < segments.size(); ++n) order[n] = {segments[n], n};
-  stableSortBy(order, [](const Numbered& item) { return item.segment.v_low; });
-  stableSortBy(order, [](const Numbered& item) { return item.segment.u; });
-  std::vector<Segment> runs;
-  std::vector<std::uint32_t> run_of_segment(segments.size());
-  for (const auto& [segment, n] : order) {
-    if (runs.empty() || runs.back().u != segment.u ||
-        static_cast<std::int64_t>(segment.v_low) - runs.back().v_high > gap_cells) {
-      runs.push_back(segment);
-    } else {
-      runs.back().v_high = std::max(runs.back().v_high, segment.v_high);
-    }
-    run_of_segment[n] = static_cast<std::uint32_t>(runs.size() - 1);
-  }
+  const ColumnRuns column_runs(segments, gap_cells);
+  const std::vector<Segment>& runs = column_runs.runs;
+  const std::vector<std::uint32_t>& run_of_segment = column_runs.run_of_segment;
   // The runs of each column: [column_first[u − min_u], column_first[u − min_u + 1]).
   const std::int32_t min_u = runs.front().u;
   const auto columns = static_cast<std::size_t>(static_cast<std::int64_t>(runs.back().u) - min_u + 1);
@@ -317,7 +313,7 @@ std::vector<Eigen::Vector3d> outlineOf(const BlockGrid& grid, const std::vector<
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;
   planeBasis(normal, u_axis, v_axis);
-  PlaneRaster raster(Footprints(grid, blocks, u_axis, v_axis, point), 1);
+  PlaneRaster raster(ColumnRuns(Footprints(grid, blocks, u_axis, v_axis, point).segments, 1).runs, 1);
   const double cell = grid.cellSize();
   for (const Eigen::Vector2i& corner : outerBoundary(raster, [](std::size_t) { return true; })) {
     outline.push_back(point + u_axis * (corner.x() * cell) + v_axis * (corner.y() * cell));
