@@ -5,12 +5,16 @@
 
 #include <algorithm>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <random>
 #include <set>
 
 #include "../src/planes/counting_sort.hpp"
+#include "../src/planes/patch_rules.hpp"
+#include "../src/planes/plane_scorer.hpp"
 #include "mlmap/planes/block_grid.hpp"
+#include "mlmap/planes/direction_vectors.hpp"
 #include "mlmap/planes/patches.hpp"
 #include "plane_scenes.hpp"
 
@@ -94,7 +98,58 @@ std::vector<std::vector<std::uint32_t>> referencePatches(const BlockGrid& grid, 
   return sorted;
 }
 
+// withEdges the slow way: rings round the plane's blocks until none joins.
+std::vector<std::uint32_t> referenceEdges(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
+                                          const PlaneScorer& scorer, const std::vector<std::uint32_t>& matching,
+                                          const CandidatePlane& plane, double epsilon, double kappa) {
+  std::set<std::uint32_t> in_plane(matching.begin(), matching.end());
+  const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * kappa, std::numbers::pi / 2)));
+  std::vector<std::uint32_t> frontier = matching;
+  while (!frontier.empty()) {
+    std::vector<std::uint32_t> next;
+    for (const std::uint32_t id : frontier) {
+      grid.forEachNeighbour(grid.blocks()[id].cell, 1, [&](std::uint32_t other) {
+        if (in_plane.count(other) != 0 || scorer.taken(other)) return;
+        const Eigen::Vector3f& direction = directions[other];
+        if (direction.squaredNorm() > 0.0F && std::abs(direction.dot(plane.normal)) < cos_edge) return;
+        if (std::abs(plane.normal.dot(grid.blocks()[other].point - plane.point)) >= static_cast<float>(epsilon)) return;
+        in_plane.insert(other);
+        next.push_back(other);
+      });
+    }
+    frontier = std::move(next);
+  }
+  return {in_plane.begin(), in_plane.end()};
+}
+
 }  // namespace
+
+TEST_CASE("withEdges: the edge blocks found from the scorer's index equal rings grown round the plane, before and after takes") {
+  test::PlaneSceneBuilder scene = patchScene();
+  scene.rectangle({1.5, 0.9, 0.0}, {0.5, 0.0, 0.3}, {0.0, 0.5, 0.0}, 0.01);  // a ramp, its edges bent
+  const BlockGrid grid(scene.map());
+  DirectionConfig direction_config;
+  const std::vector<Eigen::Vector3f> directions = directionVectors(grid, direction_config);
+  const double epsilon = 0.05;
+  const double kappa = 25.0 * std::numbers::pi / 180.0;
+  PlaneScorer scorer(grid, directions, epsilon, kappa);
+  const std::vector<CandidatePlane> planes{{Eigen::Vector3f::UnitZ(), {0.0F, 0.0F, 0.0F}},
+                                           {Eigen::Vector3f::UnitZ(), {0.0F, 0.0F, 0.72F}},
+                                           {Eigen::Vector3f::UnitX(), {0.02F, 0.0F, 0.0F}},
+                                           {Eigen::Vector3f::UnitY(), {0.0F, 1.02F, 0.0F}},
+                                           {Eigen::Vector3f(-0.51F, 0.0F, 0.86F).normalized(), {1.5F, 0.9F, 0.0F}}};
+  std::size_t grown = 0;
+  for (int round = 0; round < 2; ++round) {
+    for (const CandidatePlane& plane : planes) {
+      const std::vector<std::uint32_t> matching = scorer.matching(plane);
+      const std::vector<std::uint32_t> edges = withEdges(grid, directions, scorer, matching, plane, epsilon, kappa);
+      CHECK(edges == referenceEdges(grid, directions, scorer, matching, plane, epsilon, kappa));
+      grown += edges.size() - matching.size();
+    }
+    scorer.take(scorer.matching(planes[0]));  // the floor leaves the pool
+  }
+  CHECK(grown > 0);
+}
 
 TEST_CASE("BlockGrid: blocks numbered row by row, a Chebyshev window's blocks visited in ascending ids, map order kept") {
   test::PlaneSceneBuilder scene = patchScene();
