@@ -137,7 +137,7 @@ bool Detector::accept(std::size_t index) {
     return false;
   }
   const std::vector<std::uint32_t> matching =
-      withEdges(grid_, directions_, scorer_, strict, accepted.plane, config_.epsilon, kappa, config_.threads);
+      withEdges(grid_, directions_, scorer_, strict, accepted.plane, config_.epsilon, kappa);
   const auto split = splitIntoPatches(grid_, matching, accepted.plane.normal.cast<double>(),
                                       accepted.plane.point.cast<double>());
   const double cell_area = grid_.cellSize() * grid_.cellSize();

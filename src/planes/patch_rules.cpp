@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <span>
 
 #include "id_set.hpp"
 #include "pca_sums.hpp"
@@ -13,50 +12,37 @@ namespace mlmap {
 
 std::vector<std::uint32_t> withEdges(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                      const PlaneScorer& scorer, std::vector<std::uint32_t> matching,
-                                     const CandidatePlane& plane, double epsilon, double kappa_rad, int threads) {
-  IdSet in_plane(grid.size());
-  for (const std::uint32_t id : matching) in_plane.insert(id);
+                                     const CandidatePlane& plane, double epsilon, double kappa_rad) {
   const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * kappa_rad, std::numbers::pi / 2)));
   const auto reach = static_cast<float>(epsilon);
-  // Blocks joining in a ring around the frontier: the ring of a floor's 150 000 blocks
-  // at 2 cm is worth two threads; each keeps what it finds, and the set of blocks
-  // that join does not depend on the order they are found in.
-  auto ring = [&](std::span<const std::uint32_t> frontier, std::vector<std::uint32_t>& found) {
+  IdSet in_plane(grid.size());
+  for (const std::uint32_t id : matching) in_plane.insert(id);
+  // The blocks that may join, from the scorer's index: a few edges and strays, where a
+  // ring round every matching block visits a floor's 150 000 blocks and the ceiling's.
+  IdSet joinable(grid.size());
+  std::vector<std::uint32_t> frontier;
+  for (const std::uint32_t id : scorer.near(plane, cos_edge, reach)) {
+    if (in_plane.contains(id)) continue;
+    const Eigen::Vector3f& direction = directions[id];
+    if (direction.squaredNorm() > 0.0F && std::abs(direction.dot(plane.normal)) < cos_edge) continue;
+    if (std::abs(plane.normal.dot(grid.blocks()[id].point - plane.point)) >= reach) continue;
+    joinable.insert(id);
+    bool touches = false;
+    grid.forEachNeighbour(grid.blocks()[id].cell, 1, [&](std::uint32_t other) { touches = touches || in_plane.contains(other); });
+    if (touches) frontier.push_back(id);
+  }
+  // They join when they touch the plane's blocks, or blocks that joined.
+  for (const std::uint32_t id : frontier) in_plane.insert(id);
+  while (!frontier.empty()) {
+    std::vector<std::uint32_t> next;
     for (const std::uint32_t id : frontier) {
       grid.forEachNeighbour(grid.blocks()[id].cell, 1, [&](std::uint32_t other) {
-        if (in_plane.contains(other) || scorer.taken(other)) return;
-        const Eigen::Vector3f& direction = directions[other];
-        if (direction.squaredNorm() > 0.0F && std::abs(direction.dot(plane.normal)) < cos_edge) return;
-        if (std::abs(plane.normal.dot(grid.blocks()[other].point - plane.point)) >= reach) return;
-        found.push_back(other);
+        if (!joinable.contains(other) || in_plane.contains(other)) return;
+        in_plane.insert(other);
+        next.push_back(other);
       });
     }
-  };
-  constexpr std::size_t kParallelFrontier = 16384;
-  std::vector<std::uint32_t> frontier = std::move(matching);
-  std::vector<std::vector<std::uint32_t>> found(1);
-  while (!frontier.empty()) {
-    const std::span<const std::uint32_t> all(frontier);
-    if (frontier.size() < kParallelFrontier || threads == 1) {
-      found.resize(1);
-      found[0].clear();
-      ring(all, found[0]);
-    } else {
-      found.assign(2, {});
-      const std::size_t half = frontier.size() / 2;
-#pragma omp parallel for schedule(static) num_threads(2)
-      for (int part = 0; part < 2; ++part) {
-        ring(part == 0 ? all.first(half) : all.subspan(half), found[static_cast<std::size_t>(part)]);
-      }
-    }
-    frontier.clear();
-    for (const std::vector<std::uint32_t>& part : found) {
-      for (const std::uint32_t id : part) {
-        if (in_plane.contains(id)) continue;
-        in_plane.insert(id);
-        frontier.push_back(id);
-      }
-    }
+    frontier = std::move(next);
   }
   return in_plane.ascending();
 }

@@ -16,10 +16,10 @@ namespace mlmap {
 // Blocks on the plane's edges, where a corner or a rim bends their direction vectors
 // past κ (or leaves them none), join the plane when they touch its matching blocks, lie
 // within ε and point within 2κ of it. Otherwise room corners are left over and later
-// form small diagonal "walls". Returns the ids ascending. `threads`: 1 keeps it serial.
+// form small diagonal "walls". Returns the ids ascending.
 std::vector<std::uint32_t> withEdges(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                      const PlaneScorer& scorer, std::vector<std::uint32_t> matching,
-                                     const CandidatePlane& plane, double epsilon, double kappa_rad, int threads = 0);
+                                     const CandidatePlane& plane, double epsilon, double kappa_rad);
 
 // A curved surface (a pillar) fits planes only facet by facet, with directions fanning
 // out across each facet: a real plane's blocks agree with its normal. The mean angle,

@@ -112,7 +112,10 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   std::vector<Eigen::Vector3f> first(bins, Eigen::Vector3f::Zero());
   for (std::uint32_t id = 0; id < grid.size(); ++id) {
     const int bin = bin_of[id];
-    if (bin < 0) continue;
+    if (bin < 0) {
+      undirected_.push_back(id);
+      continue;
+    }
     const Eigen::Vector3f& d = directions[id];
     Eigen::Vector3f& reference = first[static_cast<std::size_t>(bin)];
     if (reference.squaredNorm() == 0.0F) reference = d;
@@ -149,6 +152,17 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   stableSortBy(order, [](const Place& place) { return place.layer; });
   stableSortBy(order, [](const Place& place) { return place.bin; });
   bins_.resize(bins);
+  std::size_t layer_count = 0;
+  std::size_t tile_count = 0;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const bool new_layer = k == 0 || order[k - 1].bin != order[k].bin || order[k - 1].layer != order[k].layer;
+    layer_count += new_layer ? 1 : 0;
+    tile_count += new_layer || order[k - 1].tile_u != order[k].tile_u || order[k - 1].tile_v != order[k].tile_v ? 1 : 0;
+  }
+  layers_.reserve(layer_count);
+  bin_of_layer_.reserve(layer_count);
+  tiles_.reserve(tile_count);
+  layer_of_tile_.reserve(tile_count);
   ids_.reserve(order.size());
   points_.reserve(order.size());
   block_directions_.reserve(order.size());
@@ -359,7 +373,29 @@ bool PlaneScorer::matches(std::uint32_t id, const CandidatePlane& plane) const {
 
 std::vector<std::uint32_t> PlaneScorer::matching(const CandidatePlane& plane) const {
   IdSet ids(grid_.size());
-  const Query query{plane.normal, -plane.normal.dot(plane.point), cos_kappa_, epsilon_};
+  collect(Query{plane.normal, -plane.normal.dot(plane.point), cos_kappa_, epsilon_}, nullptr, ids);
+  return ids.ascending();
+}
+
+std::vector<std::uint32_t> PlaneScorer::near(const CandidatePlane& plane, float cos_cone, float reach) const {
+  // A little wider than asked: n·p + d here, where callers test n·(p − q) (another rounding).
+  constexpr float kSlack = 1e-4F;
+  IdSet ids(grid_.size());
+  const Query query{plane.normal, -plane.normal.dot(plane.point), cos_cone - kSlack, reach + kSlack};
+  // Tiles whose blocks all match the plane are left out: the caller has those.
+  const Query matching{plane.normal, query.offset, cos_kappa_, epsilon_};
+  collect(query, &matching, ids);
+  for (const std::uint32_t id : undirected_) {
+    if (taken_[id] == 0 && std::abs(query.normal.dot(grid_.blocks()[id].point) + query.offset) < query.epsilon) {
+      ids.insert(id);
+    }
+  }
+  return ids.ascending();
+}
+
+// The untaken indexed blocks within the query's cone and slab, but for tiles wholly
+// inside `except`'s (when given).
+void PlaneScorer::collect(const Query& query, const Query* except, IdSet& ids) const {
   for (std::size_t b = 0; b < bins_.size(); ++b) {
     const Frame& frame = frames_[b];
     const Eigen::Vector3f frame_normal(std::abs(frame.a.dot(query.normal)), std::abs(frame.u.dot(query.normal)),
@@ -374,15 +410,17 @@ std::vector<std::uint32_t> PlaneScorer::matching(const CandidatePlane& plane) co
         if (tile.untaken == 0 || query.slab(tile, frame_normal) == Slab::Outside) continue;
         const Cone cone = query.cone(tile);
         if (cone == Cone::Outside) continue;
+        if (except != nullptr && except->cone(tile) == Cone::Inside && except->slab(tile, frame_normal) == Slab::Inside) {
+          continue;
+        }
         for (std::uint32_t k = tile.begin; k < tile.end; ++k) {
           if (order_taken_[k] != 0) continue;
-          if (cone == Cone::Cut && std::abs(block_directions_[k].dot(query.normal)) < cos_kappa_) continue;
-          if (std::abs(query.normal.dot(points_[k]) + query.offset) < epsilon_) ids.insert(ids_[k]);
+          if (cone == Cone::Cut && std::abs(block_directions_[k].dot(query.normal)) < query.cos_kappa) continue;
+          if (std::abs(query.normal.dot(points_[k]) + query.offset) < query.epsilon) ids.insert(ids_[k]);
         }
       }
     }
   }
-  return ids.ascending();
 }
 
 void PlaneScorer::take(const std::vector<std::uint32_t>& ids) {
