@@ -321,6 +321,7 @@ PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
     return true;
   };
   for (std::size_t b = 0; b < bins_.size(); ++b) {
+    if (bins_[b].untaken == 0) continue;  // most bins: no direction falls in them, or all taken
     const Frame& frame = frames_[b];
     const Eigen::Vector3f frame_normal(std::abs(frame.a.dot(query.normal)), std::abs(frame.u.dot(query.normal)),
                                        std::abs(frame.v.dot(query.normal)));
@@ -397,11 +398,12 @@ std::vector<std::uint32_t> PlaneScorer::near(const CandidatePlane& plane, float 
 // inside `except`'s (when given).
 void PlaneScorer::collect(const Query& query, const Query* except, IdSet& ids) const {
   for (std::size_t b = 0; b < bins_.size(); ++b) {
+    const Node& bin = bins_[b];
+    if (bin.untaken == 0) continue;
     const Frame& frame = frames_[b];
     const Eigen::Vector3f frame_normal(std::abs(frame.a.dot(query.normal)), std::abs(frame.u.dot(query.normal)),
                                        std::abs(frame.v.dot(query.normal)));
-    const Node& bin = bins_[b];
-    if (bin.untaken == 0 || query.cone(bin) == Cone::Outside || query.slab(bin, frame_normal) == Slab::Outside) continue;
+    if (query.cone(bin) == Cone::Outside || query.slab(bin, frame_normal) == Slab::Outside) continue;
     for (std::uint32_t l = bin.begin; l < bin.end; ++l) {
       const Node& layer = layers_[l];
       if (layer.untaken == 0 || query.slab(layer, frame_normal) == Slab::Outside) continue;
