@@ -30,6 +30,11 @@ int runPlanes(const PlanesArguments& arguments, bool quiet) {
               arguments.map.c_str(), stats.blocks, stats.accepted, detection.planes.size(),
               stats.candidates, stats.direction_seconds + stats.detection_seconds,
               stats.direction_seconds, stats.detection_seconds, stats.labelled_blocks);
+  const ErmsmStageSeconds& stage = stats.stages;
+  std::printf("  stages (s): noise %.3f, blocks %.3f, directions %.3f, index %.3f, search %.3f, patches %.3f, "
+              "merges %.3f, labels %.3f\n",
+              stage.noise, stage.grid, stage.directions, stage.index, stage.search, stage.patches, stage.merges,
+              stage.labels);
   std::printf("  %4s %-8s %8s %8s %7s %26s %8s %8s\n", "id", "class", "area m²", "blocks", "rms cm",
               "normal", "offset", "cands");
   for (const Plane& plane : detection.planes) {

@@ -60,7 +60,15 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
                        {"blocks_with_direction", run.blocks_with_direction}};
   json["timings"] = {{"direction_vectors_s", run.direction_seconds},
                      {"detection_s", run.detection_seconds},
-                     {"total_s", run.direction_seconds + run.detection_seconds}};
+                     {"total_s", run.direction_seconds + run.detection_seconds},
+                     {"noise_s", run.stages.noise},
+                     {"blocks_s", run.stages.grid},
+                     {"directions_s", run.stages.directions},
+                     {"index_s", run.stages.index},
+                     {"search_s", run.stages.search},
+                     {"patches_s", run.stages.patches},
+                     {"merges_s", run.stages.merges},
+                     {"labels_s", run.stages.labels}};
   nlohmann::json planes = nlohmann::json::array();
   for (const Plane& plane : detection.planes) {
     nlohmann::json outline = nlohmann::json::array();

@@ -6,89 +6,104 @@
 #include "mlmap/error.hpp"
 
 namespace mlmap {
+namespace {
+
+// How a cell's blocks join (BlockGridConfig, in the blocks' float heights).
+struct StackRule {
+  float stack_gap;
+  float level_band;
+  float ladder_gap;
+  std::size_t ladder_blocks;
+  float rung_variance;
+};
+
+// One cell's blocks as eRMSM blocks: consecutive blocks closer than the stack gap,
+// or ladders of short blocks, join (see the header).
+void appendStacks(std::span<const Block> cell_blocks, CellIndex cell, const Eigen::Vector2d& centre, double cell_size,
+                  const StackRule& rule, std::vector<PlaneBlock>& out) {
+  const float stack_gap = rule.stack_gap;
+  const float level_band = rule.level_band;
+  // A rung is a sliver of one or two scan lines: short, and if level, fused from a
+  // few points only (a table top or a seat is fused from many: not a rung).
+  const auto rung = [&](std::size_t k) {
+    const Block& block = cell_blocks[k];
+    return block.depth < rule.ladder_gap && (block.isVertical() || block.variance > rule.rung_variance);
+  };
+  for (std::size_t first = 0; first < cell_blocks.size();) {
+    // The stack: this block and the ones above it closer than the stack gap, or a
+    // ladder of rungs, then whatever lies closer than the stack gap above it.
+    std::size_t last = first;
+    float top = cell_blocks[first].height;
+    if (rung(first)) {
+      std::size_t ladder_last = first;
+      float ladder_top = top;
+      while (ladder_last + 1 < cell_blocks.size() && rung(ladder_last + 1) &&
+             cell_blocks[ladder_last + 1].bottom() - ladder_top < rule.ladder_gap) {
+        ++ladder_last;
+        ladder_top = std::max(ladder_top, cell_blocks[ladder_last].height);
+      }
+      if (ladder_last + 1 - first >= rule.ladder_blocks) {
+        last = ladder_last;
+        top = ladder_top;
+      }
+    }
+    while (last + 1 < cell_blocks.size() && cell_blocks[last + 1].bottom() - top < stack_gap) {
+      ++last;
+      top = std::max(top, cell_blocks[last].height);
+    }
+    PlaneBlock view;
+    view.top = top;
+    view.bottom = cell_blocks[first].bottom();
+    view.map_first = static_cast<std::uint16_t>(first);
+    view.map_count = static_cast<std::uint16_t>(last - first + 1);
+    // A stack shallower than the level band is the edge of a horizontal surface (a
+    // table top with its rim, a stair tread with the top of its riser) or a level
+    // surface split by range noise far more often than a wall: eRMSM treats it as
+    // horizontal, at its top when it is one vertical block, else at the members'
+    // inverse-variance mean height.
+    view.vertical = view.top - view.bottom >= level_band;
+    view.surface = view.vertical ? static_cast<float>((view.top - view.bottom) / cell_size) : 1.0F;
+    float level = view.top;
+    if (!view.vertical && last > first) {
+      double weighted = 0.0;
+      double weight = 0.0;
+      for (std::size_t k = first; k <= last; ++k) {
+        const double w = 1.0 / std::max(cell_blocks[k].variance, 1e-12F);
+        weighted += w * cell_blocks[k].height;
+        weight += w;
+      }
+      level = static_cast<float>(weighted / weight);
+    }
+    view.point = Eigen::Vector3f(static_cast<float>(centre.x()), static_cast<float>(centre.y()),
+                                 view.vertical ? 0.5F * (view.top + view.bottom) : level);
+    view.cell = cell;
+    out.push_back(view);
+    first = last + 1;
+  }
+}
+
+}  // namespace
 
 BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_size_(map.cellSize()) {
-  const auto stack_gap = static_cast<float>(config.stack_gap);
-  const auto ladder_gap = static_cast<float>(config.ladder_gap);
-  const auto ladder_blocks = static_cast<std::size_t>(std::max(config.ladder_blocks, 2));
-  const auto rung_variance = static_cast<float>(config.rung_variance);
-  const auto level_band = static_cast<float>(std::max(config.level_band, cell_size_));
+  const StackRule rule{static_cast<float>(config.stack_gap),
+                       static_cast<float>(std::max(config.level_band, cell_size_)),
+                       static_cast<float>(config.ladder_gap),
+                       static_cast<std::size_t>(std::max(config.ladder_blocks, 2)),
+                       static_cast<float>(config.rung_variance)};
   const std::size_t cell_count = map.cellCount();
-  blocks_.reserve(map.blockCount());
-  cell_first_.reserve(cell_count + 1);
+  cell_first_.assign(1, 0);
+  if (cell_count == 0) return;
   min_i_ = std::numeric_limits<std::int64_t>::max();
   min_j_ = std::numeric_limits<std::int64_t>::max();
   std::int64_t max_i = std::numeric_limits<std::int64_t>::min();
   std::int64_t max_j = std::numeric_limits<std::int64_t>::min();
   for (std::size_t n = 0; n < cell_count; ++n) {
-    cell_first_.push_back(static_cast<std::uint32_t>(blocks_.size()));
     const CellIndex cell = map.cellAt(n);
-    const Eigen::Vector2d centre = map.cellCenter(cell);
-    const std::span<const Block> cell_blocks = map.blocksAt(n);
-    for (std::size_t first = 0; first < cell_blocks.size();) {
-      // The stack: this block and the ones above it closer than the stack gap, or a
-      // ladder of short blocks, then whatever lies closer than the stack gap above it.
-      std::size_t last = first;
-      float top = cell_blocks[first].height;
-      // A rung is a sliver of one or two scan lines: short, and if level, fused from a
-      // few points only (a table top or a seat is fused from many: not a rung).
-      const auto short_block = [&](std::size_t k) {
-        const Block& block = cell_blocks[k];
-        return block.depth < ladder_gap && (block.isVertical() || block.variance > rung_variance);
-      };
-      if (short_block(first)) {
-        std::size_t rung = first;
-        float rung_top = top;
-        while (rung + 1 < cell_blocks.size() && short_block(rung + 1) &&
-               cell_blocks[rung + 1].bottom() - rung_top < ladder_gap) {
-          ++rung;
-          rung_top = std::max(rung_top, cell_blocks[rung].height);
-        }
-        if (rung + 1 - first >= ladder_blocks) {
-          last = rung;
-          top = rung_top;
-        }
-      }
-      while (last + 1 < cell_blocks.size() && cell_blocks[last + 1].bottom() - top < stack_gap) {
-        ++last;
-        top = std::max(top, cell_blocks[last].height);
-      }
-      PlaneBlock view;
-      view.top = top;
-      view.bottom = cell_blocks[first].bottom();
-      view.map_first = static_cast<std::uint16_t>(first);
-      view.map_count = static_cast<std::uint16_t>(last - first + 1);
-      // A stack shallower than the level band is the edge of a horizontal surface (a
-      // table top with its rim, a stair tread with the top of its riser) or a level
-      // surface split by range noise far more often than a wall: eRMSM treats it as
-      // horizontal, at its top when it is one vertical block, else at the members'
-      // inverse-variance mean height.
-      view.vertical = view.top - view.bottom >= level_band;
-      view.surface = view.vertical ? static_cast<float>((view.top - view.bottom) / cell_size_) : 1.0F;
-      float level = view.top;
-      if (!view.vertical && last > first) {
-        double weighted = 0.0;
-        double weight = 0.0;
-        for (std::size_t k = first; k <= last; ++k) {
-          const double w = 1.0 / std::max(cell_blocks[k].variance, 1e-12F);
-          weighted += w * cell_blocks[k].height;
-          weight += w;
-        }
-        level = static_cast<float>(weighted / weight);
-      }
-      view.point = Eigen::Vector3f(static_cast<float>(centre.x()), static_cast<float>(centre.y()),
-                                   view.vertical ? 0.5F * (view.top + view.bottom) : level);
-      view.cell = cell;
-      blocks_.push_back(view);
-      first = last + 1;
-    }
     min_i_ = std::min<std::int64_t>(min_i_, cell.i);
     min_j_ = std::min<std::int64_t>(min_j_, cell.j);
     max_i = std::max<std::int64_t>(max_i, cell.i);
     max_j = std::max<std::int64_t>(max_j, cell.j);
   }
-  cell_first_.push_back(static_cast<std::uint32_t>(blocks_.size()));
-  if (cell_count == 0) return;
   rows_ = max_i - min_i_ + 1;
   columns_ = max_j - min_j_ + 1;
   // A building at a few centimetres fits easily; a map spread over kilometres does not.
@@ -97,12 +112,35 @@ BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_siz
     throw Error("map too sparse for plane detection: " + std::to_string(rows_) + " × " +
                 std::to_string(columns_) + " cells in its bounding box");
   }
+  // The map's cell numbers on the grid first, then renumbered row by row.
   grid_.assign(static_cast<std::size_t>(rows_ * columns_), -1);
   for (std::size_t n = 0; n < cell_count; ++n) {
     const CellIndex cell = map.cellAt(n);
-    grid_[static_cast<std::size_t>((cell.i - min_i_) * columns_ + (cell.j - min_j_))] =
-        static_cast<std::int32_t>(n);
+    grid_[static_cast<std::size_t>((cell.i - min_i_) * columns_ + (cell.j - min_j_))] = static_cast<std::int32_t>(n);
   }
+  blocks_.reserve(map.blockCount());
+  cell_first_.reserve(cell_count + 1);
+  map_cell_.reserve(cell_count);
+  for (std::int32_t& slot : grid_) {
+    if (slot < 0) continue;
+    const auto map_cell = static_cast<std::size_t>(slot);
+    slot = static_cast<std::int32_t>(map_cell_.size());
+    map_cell_.push_back(static_cast<std::uint32_t>(map_cell));
+    const CellIndex cell = map.cellAt(map_cell);
+    appendStacks(map.blocksAt(map_cell), cell, map.cellCenter(cell), cell_size_, rule, blocks_);
+    cell_first_.push_back(static_cast<std::uint32_t>(blocks_.size()));
+  }
+}
+
+std::vector<std::uint32_t> BlockGrid::idsInMapOrder() const {
+  std::vector<std::uint32_t> cell_of_map_cell(map_cell_.size());
+  for (std::uint32_t n = 0; n < map_cell_.size(); ++n) cell_of_map_cell[map_cell_[n]] = n;
+  std::vector<std::uint32_t> ids;
+  ids.reserve(blocks_.size());
+  for (const std::uint32_t n : cell_of_map_cell) {
+    for (std::uint32_t id = cell_first_[n]; id < cell_first_[n + 1]; ++id) ids.push_back(id);
+  }
+  return ids;
 }
 
 }  // namespace mlmap

@@ -18,18 +18,17 @@ struct Neighbour {
   float z;       // its point's height
   float top;
   float bottom;
-  bool vertical;
 };
 
-// Blocks of one cell share their neighbourhood: it is gathered once per cell, and the
-// sums are kept in float relative to the block (offsets of a few cells, heights of a
-// few centimetres), then solved in double.
-Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const std::vector<Neighbour>& neighbours,
+// Blocks of one cell share their neighbourhood: it is gathered once per cell, each
+// class in its own list, and the sums are kept in float relative to the block (offsets
+// of a few cells, heights of a few centimetres), then solved in double.
+Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const std::vector<Neighbour>& horizontal,
                                     float height_tolerance, double min_spread) {
   float n = 0.0F, sx = 0.0F, sy = 0.0F, sz = 0.0F;
   float xx = 0.0F, xy = 0.0F, xz = 0.0F, yy = 0.0F, yz = 0.0F, zz = 0.0F;
-  for (const Neighbour& other : neighbours) {
-    if (other.vertical || std::abs(other.top - self.top) >= height_tolerance) continue;
+  for (const Neighbour& other : horizontal) {
+    if (std::abs(other.top - self.top) >= height_tolerance) continue;
     const float z = other.z - self.point.z();
     n += 1.0F;
     sx += other.dx;
@@ -54,10 +53,10 @@ Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const std::vector<Ne
   return orientConsistently(solver.eigenvectors().col(0).cast<float>());
 }
 
-Eigen::Vector3f verticalDirection(const PlaneBlock& self, const std::vector<Neighbour>& neighbours, double min_spread) {
+Eigen::Vector3f verticalDirection(const PlaneBlock& self, const std::vector<Neighbour>& vertical, double min_spread) {
   float n = 0.0F, sx = 0.0F, sy = 0.0F, xx = 0.0F, xy = 0.0F, yy = 0.0F;
-  for (const Neighbour& other : neighbours) {
-    if (!other.vertical || other.bottom > self.top || other.top < self.bottom) continue;
+  for (const Neighbour& other : vertical) {
+    if (other.bottom > self.top || other.top < self.bottom) continue;
     n += 1.0F;
     sx += other.dx;
     sy += other.dy;
@@ -104,22 +103,24 @@ std::vector<Eigen::Vector3f> directionVectors(const BlockGrid& grid, const Direc
 #endif
 #pragma omp parallel num_threads(threads)
   {
-    std::vector<Neighbour> neighbours;
+    std::vector<Neighbour> horizontal;
+    std::vector<Neighbour> vertical;
 #pragma omp for schedule(dynamic, 256)
     for (std::int64_t cell = 0; cell < cells; ++cell) {
       const std::uint32_t begin = grid.firstBlockOfCell(static_cast<std::size_t>(cell));
       const std::uint32_t end = grid.firstBlockOfCell(static_cast<std::size_t>(cell) + 1);
       if (begin == end) continue;
       const Eigen::Vector3f& centre = blocks[begin].point;
-      neighbours.clear();
+      horizontal.clear();
+      vertical.clear();
       grid.forEachNeighbour(blocks[begin].cell, config.radius, [&](std::uint32_t other) {
         const PlaneBlock& block = blocks[other];
-        neighbours.push_back({block.point.x() - centre.x(), block.point.y() - centre.y(), block.point.z(), block.top,
-                              block.bottom, block.vertical});
+        (block.vertical ? vertical : horizontal)
+            .push_back({block.point.x() - centre.x(), block.point.y() - centre.y(), block.point.z(), block.top, block.bottom});
       });
       for (std::uint32_t id = begin; id < end; ++id) {
-        directions[id] = blocks[id].vertical ? verticalDirection(blocks[id], neighbours, min_spread)
-                                             : horizontalDirection(blocks[id], neighbours, config.height_tolerance, min_spread);
+        directions[id] = blocks[id].vertical ? verticalDirection(blocks[id], vertical, min_spread)
+                                             : horizontalDirection(blocks[id], horizontal, config.height_tolerance, min_spread);
       }
     }
   }

@@ -57,10 +57,10 @@ class Detector {
       : grid_(grid),
         directions_(directions),
         config_(config),
-        scorer_(grid, directions, config.epsilon, radians(config.kappa_deg)),
+        scorer_(grid, directions, config.epsilon, radians(config.kappa_deg), config.threads),
         min_score_(config.min_area / (grid.cellSize() * grid.cellSize())) {
     patches_.labels.assign(grid.size(), 0);
-    for (std::uint32_t id = 0; id < grid_.size(); ++id) {
+    for (const std::uint32_t id : grid_.idsInMapOrder()) {
       if (directions_[id].squaredNorm() > 0.0F) seedable_.push_back(id);
     }
   }
@@ -84,7 +84,7 @@ class Detector {
   const ErmsmConfig& config_;
   PlaneScorer scorer_;
   double min_score_;
-  std::vector<std::uint32_t> seedable_;  // blocks with a direction vector, taken ones pruned now and then
+  std::vector<std::uint32_t> seedable_;  // blocks with a direction vector, in map order; taken ones pruned now and then
   std::size_t seedable_taken_ = 0;       // of which taken
   std::vector<Candidate> candidates_;    // L_c
   std::size_t unlisted_ = 0;             // drawn candidates too small to ever be accepted
@@ -187,17 +187,17 @@ bool Detector::accept(std::size_t index) {
 }
 
 PatchSet Detector::run(ErmsmStats& stats) {
+  const auto start = Clock::now();
   stats_ = &stats;
   const int batch = std::max(1, config_.batch_size);
-#ifdef _OPENMP
-  const int threads = config_.threads > 0 ? config_.threads : omp_get_max_threads();
-#endif
   std::uint64_t generated = 0;
   int empty_batches = 0;
   while (generated < static_cast<std::uint64_t>(config_.max_candidates) && seedable_.size() - seedable_taken_ >= 3) {
     std::vector<CandidateDraw> draws(static_cast<std::size_t>(batch));
     const CandidateSource candidate_source = source();
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    // One thread: a batch takes well under a millisecond, and a parallel region per
+    // batch costs more than it saves on a shared machine — at 2 threads the search took
+    // 0.013 to 0.5 s on the 10 cm corridor, depending on what else ran; 0.02 s on one.
     for (int k = 0; k < batch; ++k) {
       draws[static_cast<std::size_t>(k)] =
           drawCandidate(candidate_source, config_.seed, generated + static_cast<std::uint64_t>(k), candidates_);
@@ -227,22 +227,35 @@ PatchSet Detector::run(ErmsmStats& stats) {
     // unlikely to have been overlooked.
     while (const auto best = bestCandidate()) {
       if (acceptanceProbability(candidates_[*best]) < config_.min_probability) break;
+      const auto accept_start = Clock::now();
       accept(*best);
+      stats.stages.patches += secondsSince(accept_start);
       if (seedable_.size() - seedable_taken_ < 3) break;
     }
   }
   stats.accepted = static_cast<std::size_t>(accepted_);
+  stats.stages.search = secondsSince(start) - stats.stages.patches;
+  const auto merge_start = Clock::now();
   // Block points sit at cell centres: pieces of one surface lie up to half a cell
   // further apart than ε allows a block.
   mergeCoplanar(grid_, patches_, config_.epsilon + 0.5 * grid_.cellSize(), radians(config_.kappa_deg));
+  stats.stages.merges = secondsSince(merge_start);
   return std::move(patches_);
 }
 
 }  // namespace
 
 PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
-  auto start = Clock::now();
+  const auto start = Clock::now();
+  auto stage_start = start;
   PlaneDetection detection;
+  ErmsmStats& stats = detection.stats;
+  // Seconds since the last call: the stage that just ended.
+  auto stage = [&stage_start] {
+    const double seconds = secondsSince(stage_start);
+    stage_start = Clock::now();
+    return seconds;
+  };
   ErmsmConfig& config = detection.config;
   config = input_config;
   if (config.noise <= 0.0) config.noise = rangeNoise(map);
@@ -252,6 +265,7 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   for (std::size_t n = 0; n < map.cellCount(); ++n) {
     for (Block& block : map.mutableBlocksAt(n)) block.plane = 0;
   }
+  stats.stages.noise = stage();
   // A level rung is fused from a few points (under ten): its variance is a good part
   // of one point's σ², a table top's far below it.
   const BlockGrid grid(map, BlockGridConfig{.stack_gap = config.stack_gap,
@@ -259,25 +273,29 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
                                             .ladder_gap = config.ladder_gap,
                                             .ladder_blocks = config.ladder_blocks,
                                             .rung_variance = 0.1 * config.noise * config.noise});
+  stats.stages.grid = stage();
   DirectionConfig direction_config;
   direction_config.radius = config.radius;
   direction_config.height_tolerance = static_cast<float>(config.epsilon);
   direction_config.threads = config.threads;
   const std::vector<Eigen::Vector3f> directions = directionVectors(grid, direction_config);
-  ErmsmStats& stats = detection.stats;
+  stats.stages.directions = stage();
   stats.direction_seconds = secondsSince(start);
   stats.blocks = grid.size();
   stats.blocks_with_direction = static_cast<std::size_t>(
       std::count_if(directions.begin(), directions.end(), [](const Eigen::Vector3f& d) { return d.squaredNorm() > 0.0F; }));
 
-  start = Clock::now();
+  const auto detection_start = Clock::now();
   Detector detector(grid, directions, config);
+  stats.stages.index = stage();
   PatchSet patches = detector.run(stats);
+  stage();
   classifyPlanes(patches.planes);
   mergeLevels(grid, patches, radians(config.kappa_deg));
+  stats.stages.merges += stage();
   detection.planes = std::move(patches.planes);
-  for (std::size_t n = 0; n < map.cellCount(); ++n) {
-    const auto blocks = map.mutableBlocksAt(n);
+  for (std::size_t n = 0; n < grid.cellCount(); ++n) {
+    const auto blocks = map.mutableBlocksAt(grid.mapCellOf(n));
     for (std::uint32_t id = grid.firstBlockOfCell(n); id < grid.firstBlockOfCell(n + 1); ++id) {
       const PlaneBlock& block = grid.blocks()[id];
       for (std::size_t k = block.map_first; k < block.map_first + block.map_count; ++k) {
@@ -286,8 +304,9 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
       }
     }
   }
+  stats.stages.labels = stage();
   // Everything after the direction vectors, the labels written back included.
-  stats.detection_seconds = secondsSince(start);
+  stats.detection_seconds = secondsSince(detection_start);
   return detection;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "id_set.hpp"
 #include "pca_sums.hpp"
 
 namespace mlmap {
@@ -12,28 +13,38 @@ namespace mlmap {
 std::vector<std::uint32_t> withEdges(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                      const PlaneScorer& scorer, std::vector<std::uint32_t> matching,
                                      const CandidatePlane& plane, double epsilon, double kappa_rad) {
-  std::vector<std::uint8_t> in_plane(grid.size(), 0);
-  for (const std::uint32_t id : matching) in_plane[id] = 1;
   const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * kappa_rad, std::numbers::pi / 2)));
   const auto reach = static_cast<float>(epsilon);
-  std::vector<std::uint32_t> frontier = matching;
+  IdSet in_plane(grid.size());
+  for (const std::uint32_t id : matching) in_plane.insert(id);
+  // The blocks that may join, from the scorer's index: a few edges and strays, where a
+  // ring round every matching block visits a floor's 150 000 blocks and the ceiling's.
+  IdSet joinable(grid.size());
+  std::vector<std::uint32_t> frontier;
+  for (const std::uint32_t id : scorer.near(plane, cos_edge, reach)) {
+    if (in_plane.contains(id)) continue;
+    const Eigen::Vector3f& direction = directions[id];
+    if (direction.squaredNorm() > 0.0F && std::abs(direction.dot(plane.normal)) < cos_edge) continue;
+    if (std::abs(plane.normal.dot(grid.blocks()[id].point - plane.point)) >= reach) continue;
+    joinable.insert(id);
+    bool touches = false;
+    grid.forEachNeighbour(grid.blocks()[id].cell, 1, [&](std::uint32_t other) { touches = touches || in_plane.contains(other); });
+    if (touches) frontier.push_back(id);
+  }
+  // They join when they touch the plane's blocks, or blocks that joined.
+  for (const std::uint32_t id : frontier) in_plane.insert(id);
   while (!frontier.empty()) {
     std::vector<std::uint32_t> next;
     for (const std::uint32_t id : frontier) {
       grid.forEachNeighbour(grid.blocks()[id].cell, 1, [&](std::uint32_t other) {
-        if (in_plane[other] != 0 || scorer.taken(other)) return;
-        const Eigen::Vector3f& direction = directions[other];
-        if (direction.squaredNorm() > 0.0F && std::abs(direction.dot(plane.normal)) < cos_edge) return;
-        if (std::abs(plane.normal.dot(grid.blocks()[other].point - plane.point)) >= reach) return;
-        in_plane[other] = 1;
+        if (!joinable.contains(other) || in_plane.contains(other)) return;
+        in_plane.insert(other);
         next.push_back(other);
       });
     }
-    matching.insert(matching.end(), next.begin(), next.end());
     frontier = std::move(next);
   }
-  std::sort(matching.begin(), matching.end());
-  return matching;
+  return in_plane.ascending();
 }
 
 double directionSpread(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,

@@ -47,11 +47,21 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
     merged.push_back(std::move(plane));
   }
   std::vector<std::vector<std::uint32_t>> merged_blocks(merged.size());
+  std::vector<std::size_t> members_of(merged.size(), 0);
   for (std::size_t k = 0; k < count; ++k) {
-    auto& blocks = merged_blocks[static_cast<std::size_t>(new_id[k] - 1)];
-    blocks.insert(blocks.end(), set.blocks[k].begin(), set.blocks[k].end());
+    const auto merged_index = static_cast<std::size_t>(new_id[k] - 1);
+    auto& blocks = merged_blocks[merged_index];
+    if (blocks.empty()) {
+      blocks = std::move(set.blocks[k]);
+    } else {
+      blocks.insert(blocks.end(), set.blocks[k].begin(), set.blocks[k].end());
+    }
+    ++members_of[merged_index];
   }
-  for (auto& blocks : merged_blocks) std::sort(blocks.begin(), blocks.end());
+  // A plane alone keeps its ascending blocks.
+  for (std::size_t m = 0; m < merged.size(); ++m) {
+    if (members_of[m] > 1) std::sort(merged_blocks[m].begin(), merged_blocks[m].end());
+  }
   set.planes = std::move(merged);
   set.blocks = std::move(merged_blocks);
   for (std::int32_t& label : set.labels) {

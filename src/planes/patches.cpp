@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
 #include <numeric>
+
+#include "counting_sort.hpp"
 
 namespace mlmap {
 namespace {
@@ -28,71 +29,122 @@ class DisjointSets {
   std::vector<std::size_t> parent_;
 };
 
-// Blocks rasterised on a grid of cell_size in the plane: a dense raster over their
-// bounding box with a margin (planes in a building are compact, and lookups in an
-// array beat a hash map by far). Raster cell (u, v) covers [u, u + 1) × [v, v + 1) cells
-// along the plane basis from `point`.
+// A block's footprint on the plane's raster: raster cells (u, v) with v in [v_low, v_high].
+struct Segment {
+  std::int32_t u;
+  std::int32_t v_low;
+  std::int32_t v_high;
+};
+
+// The footprints of the blocks on a raster of cell_size along the plane basis from
+// `point`: raster cell (u, v) covers [u, u + 1) × [v, v + 1) cells. A horizontal block
+// covers the cell of its point, a vertical block every cell its extent crosses: with u
+// level (any plane but a near-horizontal one) that is one run of v at the u of its
+// point, else the cells of points along its extent a cell apart. Block k's segments are
+// [first_of_block[k], first_of_block[k + 1]), the one of its point first.
+struct Footprints {
+  std::vector<Segment> segments;
+  std::vector<std::size_t> first_of_block;
+
+  Footprints(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& u_axis,
+             const Eigen::Vector3d& v_axis, const Eigen::Vector3d& point) {
+    const double cell = grid.cellSize();
+    auto cellOf = [&](const Eigen::Vector3d& p) {
+      const Eigen::Vector3d relative = p - point;
+      return Eigen::Vector2i(static_cast<std::int32_t>(std::floor(relative.dot(u_axis) / cell)),
+                             static_cast<std::int32_t>(std::floor(relative.dot(v_axis) / cell)));
+    };
+    // planeBasis makes u = z × n: level exactly, so a vertical block keeps one u.
+    const bool level_u = u_axis.z() == 0.0;
+    segments.reserve(blocks.size());
+    first_of_block.resize(blocks.size() + 1);
+    for (std::size_t k = 0; k < blocks.size(); ++k) {
+      first_of_block[k] = segments.size();
+      const PlaneBlock& block = grid.blocks()[blocks[k]];
+      const Eigen::Vector3d centre = block.point.cast<double>();
+      const Eigen::Vector2i centre_cell = cellOf(centre);
+      segments.push_back({centre_cell.x(), centre_cell.y(), centre_cell.y()});
+      if (!block.vertical) continue;
+      const double depth = block.top - block.bottom;
+      const int steps = std::max(1, static_cast<int>(std::ceil(depth / cell)));
+      auto sample = [&](int s) { return cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.bottom + depth * s / steps)); };
+      if (level_u) {
+        // v grows with height (v_z ≥ 0) by at most a cell per step: one run.
+        segments.push_back({centre_cell.x(), sample(0).y(), sample(steps).y()});
+      } else {
+        for (int s = 0; s <= steps; ++s) {
+          const Eigen::Vector2i c = sample(s);
+          segments.push_back({c.x(), c.y(), c.y()});
+        }
+      }
+    }
+    first_of_block[blocks.size()] = segments.size();
+  }
+};
+
+// The footprints merged per raster column: segments of a column whose rows are at most
+// `join_gap` apart join into one run (1: touching or overlapping ones). Runs are ordered
+// by u, then v, and disjoint; run_of_segment names each segment's run.
+struct ColumnRuns {
+  std::vector<Segment> runs;
+  std::vector<std::uint32_t> run_of_segment;
+
+  ColumnRuns(const std::vector<Segment>& segments, int join_gap) : run_of_segment(segments.size()) {
+    struct Numbered {
+      Segment segment;
+      std::uint32_t number;
+    };
+    std::vector<Numbered> order(segments.size());
+    for (std::uint32_t n = 0; n < segments.size(); ++n) order[n] = {segments[n], n};
+    stableSortBy(order, [](const Numbered& item) { return item.segment.v_low; });
+    stableSortBy(order, [](const Numbered& item) { return item.segment.u; });
+    for (const auto& [segment, n] : order) {
+      if (runs.empty() || runs.back().u != segment.u ||
+          static_cast<std::int64_t>(segment.v_low) - runs.back().v_high > join_gap) {
+        runs.push_back(segment);
+      } else {
+        runs.back().v_high = std::max(runs.back().v_high, segment.v_high);
+      }
+      run_of_segment[n] = static_cast<std::uint32_t>(runs.size() - 1);
+    }
+  }
+};
+
+// The occupied raster cells in a dense raster over their bounding box with a margin
+// (planes in a building are compact, and lookups in an array beat a hash map by far).
+// Built from touching runs, so each cell is listed once: the many blocks of a wall's
+// thickness at 2 cm all cover the same cells.
 struct PlaneRaster {
   std::int32_t min_u = 0;
   std::int32_t min_v = 0;
   std::int64_t columns = 0;
   std::int64_t rows = 0;
   int margin = 0;
-  std::vector<std::int32_t> slots;         // per raster cell: its number among the occupied ones, −1 empty
-  std::vector<Eigen::Vector2i> cells;      // occupied cells, in order of first use
-  std::vector<std::size_t> first_of_block; // a block's cells in block_cells: [first_of_block[k], first_of_block[k + 1])
-  std::vector<std::size_t> block_cells;    // occupied-cell numbers
+  std::vector<std::int32_t> slots;     // per raster cell: its number among the occupied ones, −1 empty
+  std::vector<Eigen::Vector2i> cells;  // occupied cells, column by column
 
   std::int32_t& at(std::int64_t u, std::int64_t v) {
     return slots[static_cast<std::size_t>((v - min_v + margin) * columns + (u - min_u + margin))];
   }
 
-  PlaneRaster(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& u_axis,
-              const Eigen::Vector3d& v_axis, const Eigen::Vector3d& point, int margin_cells)
-      : margin(margin_cells) {
-    const double cell = grid.cellSize();
-    std::vector<Eigen::Vector2i> raw;
-    first_of_block.resize(blocks.size() + 1);
-    auto cellOf = [&](const Eigen::Vector3d& p) {
-      const Eigen::Vector3d relative = p - point;
-      return Eigen::Vector2i(static_cast<std::int32_t>(std::floor(relative.dot(u_axis) / cell)),
-                             static_cast<std::int32_t>(std::floor(relative.dot(v_axis) / cell)));
-    };
-    for (std::size_t k = 0; k < blocks.size(); ++k) {
-      first_of_block[k] = raw.size();
-      const PlaneBlock& block = grid.blocks()[blocks[k]];
-      const Eigen::Vector3d centre = block.point.cast<double>();
-      raw.push_back(cellOf(centre));
-      if (!block.vertical) continue;
-      const double depth = block.top - block.bottom;
-      const int steps = std::max(1, static_cast<int>(std::ceil(depth / cell)));
-      for (int s = 0; s <= steps; ++s) {
-        raw.push_back(cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.bottom + depth * s / steps)));
-      }
-    }
-    first_of_block[blocks.size()] = raw.size();
-    if (raw.empty()) return;
-    min_u = raw[0].x();
-    min_v = raw[0].y();
-    std::int32_t max_u = min_u;
-    std::int32_t max_v = min_v;
-    for (const Eigen::Vector2i& c : raw) {
-      min_u = std::min(min_u, c.x());
-      max_u = std::max(max_u, c.x());
-      min_v = std::min(min_v, c.y());
-      max_v = std::max(max_v, c.y());
+  PlaneRaster(const std::vector<Segment>& runs, int margin_cells) : margin(margin_cells) {
+    if (runs.empty()) return;
+    min_u = runs.front().u;
+    const std::int32_t max_u = runs.back().u;
+    min_v = runs.front().v_low;
+    std::int32_t max_v = runs.front().v_high;
+    for (const Segment& run : runs) {
+      min_v = std::min(min_v, run.v_low);
+      max_v = std::max(max_v, run.v_high);
     }
     columns = static_cast<std::int64_t>(max_u) - min_u + 1 + 2 * margin;
     rows = static_cast<std::int64_t>(max_v) - min_v + 1 + 2 * margin;
     slots.assign(static_cast<std::size_t>(columns * rows), -1);
-    block_cells.resize(raw.size());
-    for (std::size_t n = 0; n < raw.size(); ++n) {
-      std::int32_t& slot = at(raw[n].x(), raw[n].y());
-      if (slot < 0) {
-        slot = static_cast<std::int32_t>(cells.size());
-        cells.push_back(raw[n]);
+    for (const Segment& run : runs) {
+      for (std::int32_t v = run.v_low; v <= run.v_high; ++v) {
+        at(run.u, v) = static_cast<std::int32_t>(cells.size());
+        cells.emplace_back(run.u, v);
       }
-      block_cells[n] = static_cast<std::size_t>(slot);
     }
   }
 };
@@ -134,6 +186,10 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
     if (!occupied(u - 1, v)) addEdge({u, v + 1}, {u, v});
   }
   std::vector<std::uint8_t> used(edge_from.size(), 0);
+  auto before = [](const Eigen::Vector2i& a, const Eigen::Vector2i& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  };
+  auto lowest = [&](const std::vector<Eigen::Vector2i>& loop) { return *std::min_element(loop.begin(), loop.end(), before); };
   std::vector<Eigen::Vector2i> best;
   long best_area = 0;
   for (std::size_t start = 0; start < edge_from.size(); ++start) {
@@ -141,11 +197,22 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
     std::vector<Eigen::Vector2i> loop;
     std::int32_t edge = static_cast<std::int32_t>(start);
     while (edge >= 0 && used[static_cast<std::size_t>(edge)] == 0) {
-      used[static_cast<std::size_t>(edge)] = 1;
-      loop.push_back(edge_from[static_cast<std::size_t>(edge)]);
-      const Eigen::Vector2i& to = edge_to[static_cast<std::size_t>(edge)];
+      const auto current = static_cast<std::size_t>(edge);
+      used[current] = 1;
+      loop.push_back(edge_from[current]);
+      const Eigen::Vector2i& to = edge_to[current];
+      const Eigen::Vector2i in = to - edge_from[current];
       const auto& next = out[vertexOf(to.x(), to.y())];
-      edge = next[0] >= 0 && used[static_cast<std::size_t>(next[0])] == 0 ? next[0] : next[1];
+      edge = -1;
+      for (const std::int32_t candidate : next) {
+        if (candidate < 0 || used[static_cast<std::size_t>(candidate)] != 0) continue;
+        // Where two cells touch at a corner only, both their sides leave the vertex:
+        // turn right, into the other cell's boundary, so the loop goes round both (the
+        // choice must not depend on the order the cells were listed in).
+        const Eigen::Vector2i out_direction =
+            edge_to[static_cast<std::size_t>(candidate)] - edge_from[static_cast<std::size_t>(candidate)];
+        if (edge < 0 || in.x() * out_direction.y() - in.y() * out_direction.x() < 0) edge = candidate;
+      }
     }
     long twice_area = 0;
     for (std::size_t k = 0; k < loop.size(); ++k) {
@@ -153,7 +220,8 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
       const auto& b = loop[(k + 1) % loop.size()];
       twice_area += static_cast<long>(a.x()) * b.y() - static_cast<long>(b.x()) * a.y();
     }
-    if (twice_area > best_area) {
+    // Of loops of equal area, the one with the lowest corner: not the one found first.
+    if (twice_area > best_area || (twice_area == best_area && twice_area > 0 && before(lowest(loop), lowest(best)))) {
       best_area = twice_area;
       best = std::move(loop);
     }
@@ -166,6 +234,8 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
     const Eigen::Vector2i b = next_point - best[k];
     if (a.x() * b.y() - a.y() * b.x() != 0) corners.push_back(best[k]);
   }
+  // From the lowest corner (smallest u, then v), whichever edge the loop was found from.
+  std::rotate(corners.begin(), std::min_element(corners.begin(), corners.end(), before), corners.end());
   return corners;
 }
 
@@ -185,28 +255,52 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;
   planeBasis(normal, u_axis, v_axis);
-  PlaneRaster raster(grid, blocks, u_axis, v_axis, point, gap_cells);
-  DisjointSets sets(raster.cells.size());
-  for (std::size_t n = 0; n < raster.cells.size(); ++n) {
-    // Half the neighbourhood suffices: the other half links back to this cell.
-    for (int dv = 0; dv <= gap_cells; ++dv) {
-      for (int du = -gap_cells; du <= gap_cells; ++du) {
-        if (dv == 0 && du <= 0) continue;
-        const std::int32_t other = raster.at(raster.cells[n].x() + du, raster.cells[n].y() + dv);
-        if (other >= 0) sets.unite(n, static_cast<std::size_t>(other));
+  const Footprints footprints(grid, blocks, u_axis, v_axis, point);
+  const std::vector<Segment>& segments = footprints.segments;
+  // Cells are connected within gap_cells (Chebyshev). Not cell by cell (a wall at 2 cm
+  // rasterises to over half a million cells): in each raster column u, segments less
+  // than gap_cells apart join into runs, and runs of columns up to gap_cells apart
+  // connect when their closest cells are: when neither starts more than gap_cells past
+  // the other's end. (Both runs' ends are occupied, and no cell inside a run is more
+  // than gap_cells / 2 from an occupied one.)
+  const ColumnRuns column_runs(segments, gap_cells);
+  const std::vector<Segment>& runs = column_runs.runs;
+  const std::vector<std::uint32_t>& run_of_segment = column_runs.run_of_segment;
+  // The runs of each column: [column_first[u − min_u], column_first[u − min_u + 1]).
+  const std::int32_t min_u = runs.front().u;
+  const auto columns = static_cast<std::size_t>(static_cast<std::int64_t>(runs.back().u) - min_u + 1);
+  std::vector<std::uint32_t> column_first(columns + 1, 0);
+  for (const Segment& run : runs) ++column_first[static_cast<std::size_t>(run.u - min_u) + 1];
+  for (std::size_t c = 1; c <= columns; ++c) column_first[c] += column_first[c - 1];
+  DisjointSets sets(runs.size());
+  for (std::size_t column = 0; column < columns; ++column) {
+    for (std::size_t other = column + 1; other <= std::min(columns - 1, column + static_cast<std::size_t>(gap_cells));
+         ++other) {
+      // Both columns' runs are ordered by v and disjoint: one sweep pairs them.
+      std::uint32_t b = column_first[other];
+      for (std::uint32_t a = column_first[column]; a < column_first[column + 1]; ++a) {
+        while (b < column_first[other + 1] && static_cast<std::int64_t>(runs[a].v_low) - runs[b].v_high > gap_cells) ++b;
+        for (std::uint32_t c = b;
+             c < column_first[other + 1] && static_cast<std::int64_t>(runs[c].v_low) - runs[a].v_high <= gap_cells; ++c) {
+          sets.unite(a, c);
+        }
       }
     }
   }
-  // Components keyed by their root; roots are the smallest cell number, so the
-  // order is deterministic.
-  std::map<std::size_t, Patch> by_root;
+  // Patches in the order of their first block (the order of the blocks' first raster
+  // cells), then largest first.
+  std::vector<std::int32_t> patch_of_root(runs.size(), -1);
+  std::vector<Patch> patches;
   for (std::size_t k = 0; k < blocks.size(); ++k) {
-    Patch& patch = by_root[sets.find(raster.block_cells[raster.first_of_block[k]])];
+    const std::size_t root = sets.find(run_of_segment[footprints.first_of_block[k]]);
+    if (patch_of_root[root] < 0) {
+      patch_of_root[root] = static_cast<std::int32_t>(patches.size());
+      patches.emplace_back();
+    }
+    Patch& patch = patches[static_cast<std::size_t>(patch_of_root[root])];
     patch.blocks.push_back(blocks[k]);
     patch.surface += grid.blocks()[blocks[k]].surface;
   }
-  std::vector<Patch> patches;
-  for (auto& [root, patch] : by_root) patches.push_back(std::move(patch));
   std::stable_sort(patches.begin(), patches.end(),
                    [](const Patch& a, const Patch& b) { return a.surface > b.surface; });
   return patches;
@@ -219,7 +313,7 @@ std::vector<Eigen::Vector3d> outlineOf(const BlockGrid& grid, const std::vector<
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;
   planeBasis(normal, u_axis, v_axis);
-  PlaneRaster raster(grid, blocks, u_axis, v_axis, point, 1);
+  PlaneRaster raster(ColumnRuns(Footprints(grid, blocks, u_axis, v_axis, point).segments, 1).runs, 1);
   const double cell = grid.cellSize();
   for (const Eigen::Vector2i& corner : outerBoundary(raster, [](std::size_t) { return true; })) {
     outline.push_back(point + u_axis * (corner.x() * cell) + v_axis * (corner.y() * cell));

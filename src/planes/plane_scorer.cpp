@@ -6,7 +6,13 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
-#include <tuple>
+
+#include "counting_sort.hpp"
+#include "id_set.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace mlmap {
 namespace {
@@ -82,7 +88,7 @@ struct PlaneScorer::Query {
 };
 
 PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
-                         double epsilon, double kappa_rad)
+                         double epsilon, double kappa_rad, int threads)
     : grid_(grid),
       directions_(directions),
       epsilon_(static_cast<float>(epsilon)),
@@ -93,13 +99,24 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   // Each bin's axis: the mean of its members' directions (so a bin of wall blocks,
   // whose directions are level, has a level axis), and a frame across it.
   std::vector<std::int32_t> bin_of(grid.size(), -1);
+  const auto count = static_cast<std::int64_t>(grid.size());
+#ifdef _OPENMP
+  const int team = threads > 0 ? threads : omp_get_max_threads();
+#endif
+#pragma omp parallel for schedule(static) num_threads(team)
+  for (std::int64_t id = 0; id < count; ++id) {
+    const Eigen::Vector3f& d = directions[static_cast<std::size_t>(id)];
+    if (d.squaredNorm() > 0.0F) bin_of[static_cast<std::size_t>(id)] = binOf(d);
+  }
   std::vector<Eigen::Vector3f> sums(bins, Eigen::Vector3f::Zero());
   std::vector<Eigen::Vector3f> first(bins, Eigen::Vector3f::Zero());
   for (std::uint32_t id = 0; id < grid.size(); ++id) {
+    const int bin = bin_of[id];
+    if (bin < 0) {
+      undirected_.push_back(id);
+      continue;
+    }
     const Eigen::Vector3f& d = directions[id];
-    if (d.squaredNorm() == 0.0F) continue;
-    const int bin = binOf(d);
-    bin_of[id] = bin;
     Eigen::Vector3f& reference = first[static_cast<std::size_t>(bin)];
     if (reference.squaredNorm() == 0.0F) reference = d;
     sums[static_cast<std::size_t>(bin)] += d.dot(reference) < 0.0F ? Eigen::Vector3f(-d) : d;
@@ -114,23 +131,53 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   }
   const double layer_size = 0.5 * epsilon;
   const double tile_size = kTileCells * grid.cellSize();
-  using Key = std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int32_t, std::uint32_t>;
-  std::vector<Key> keys;
+  // Each block's place in the index: its bin, its layer in the bin, its tile in the layer.
+  struct Place {
+    std::int32_t bin, layer, tile_u, tile_v;
+    std::uint32_t id;
+  };
+  std::vector<Place> order;
   for (std::uint32_t id = 0; id < grid.size(); ++id) {
     if (bin_of[id] < 0) continue;
     const Frame& frame = frames_[static_cast<std::size_t>(bin_of[id])];
     const Eigen::Vector3f& p = grid.blocks()[id].point;
-    keys.emplace_back(bin_of[id], static_cast<std::int32_t>(std::floor(frame.a.dot(p) / layer_size)),
-                      static_cast<std::int32_t>(std::floor(frame.u.dot(p) / tile_size)),
-                      static_cast<std::int32_t>(std::floor(frame.v.dot(p) / tile_size)), id);
+    order.push_back({bin_of[id], static_cast<std::int32_t>(std::floor(frame.a.dot(p) / layer_size)),
+                     static_cast<std::int32_t>(std::floor(frame.u.dot(p) / tile_size)),
+                     static_cast<std::int32_t>(std::floor(frame.v.dot(p) / tile_size)), id});
   }
-  std::sort(keys.begin(), keys.end());
+  // Ordered by (bin, layer, tile), ids ascending within a tile: stable sorts from the
+  // least significant key (a comparison sort of the 5-tuples cost far more).
+  stableSortBy(order, [](const Place& place) { return place.tile_v; });
+  stableSortBy(order, [](const Place& place) { return place.tile_u; });
+  stableSortBy(order, [](const Place& place) { return place.layer; });
+  stableSortBy(order, [](const Place& place) { return place.bin; });
   bins_.resize(bins);
-  for (std::size_t k = 0; k < keys.size(); ++k) {
-    const auto [bin, layer, tu, tv, id] = keys[k];
-    const bool new_bin = k == 0 || std::get<0>(keys[k - 1]) != bin;
-    const bool new_layer = new_bin || std::get<1>(keys[k - 1]) != layer;
-    const bool new_tile = new_layer || std::get<2>(keys[k - 1]) != tu || std::get<3>(keys[k - 1]) != tv;
+  std::size_t layer_count = 0;
+  std::size_t tile_count = 0;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const bool new_layer = k == 0 || order[k - 1].bin != order[k].bin || order[k - 1].layer != order[k].layer;
+    layer_count += new_layer ? 1 : 0;
+    tile_count += new_layer || order[k - 1].tile_u != order[k].tile_u || order[k - 1].tile_v != order[k].tile_v ? 1 : 0;
+  }
+  layers_.reserve(layer_count);
+  bin_of_layer_.reserve(layer_count);
+  tiles_.reserve(tile_count);
+  layer_of_tile_.reserve(tile_count);
+  ids_.reserve(order.size());
+  points_.reserve(order.size());
+  block_directions_.reserve(order.size());
+  surfaces_.reserve(order.size());
+  half_depths_.reserve(order.size());
+  order_taken_.reserve(order.size());
+  tile_of_.reserve(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const Place& place = order[k];
+    const std::uint32_t id = place.id;
+    const Place* previous = k == 0 ? nullptr : &order[k - 1];
+    const auto bin = place.bin;
+    const bool new_bin = previous == nullptr || previous->bin != bin;
+    const bool new_layer = new_bin || previous->layer != place.layer;
+    const bool new_tile = new_layer || previous->tile_u != place.tile_u || previous->tile_v != place.tile_v;
     if (new_bin) bins_[static_cast<std::size_t>(bin)].begin = static_cast<std::uint32_t>(layers_.size());
     if (new_layer) {
       layers_.emplace_back();
@@ -274,6 +321,7 @@ PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
     return true;
   };
   for (std::size_t b = 0; b < bins_.size(); ++b) {
+    if (bins_[b].untaken == 0) continue;  // most bins: no direction falls in them, or all taken
     const Frame& frame = frames_[b];
     const Eigen::Vector3f frame_normal(std::abs(frame.a.dot(query.normal)), std::abs(frame.u.dot(query.normal)),
                                        std::abs(frame.v.dot(query.normal)));
@@ -325,14 +373,37 @@ bool PlaneScorer::matches(std::uint32_t id, const CandidatePlane& plane) const {
 }
 
 std::vector<std::uint32_t> PlaneScorer::matching(const CandidatePlane& plane) const {
-  std::vector<std::uint32_t> ids;
-  const Query query{plane.normal, -plane.normal.dot(plane.point), cos_kappa_, epsilon_};
+  IdSet ids(grid_.size());
+  collect(Query{plane.normal, -plane.normal.dot(plane.point), cos_kappa_, epsilon_}, nullptr, ids);
+  return ids.ascending();
+}
+
+std::vector<std::uint32_t> PlaneScorer::near(const CandidatePlane& plane, float cos_cone, float reach) const {
+  // A little wider than asked: n·p + d here, where callers test n·(p − q) (another rounding).
+  constexpr float kSlack = 1e-4F;
+  IdSet ids(grid_.size());
+  const Query query{plane.normal, -plane.normal.dot(plane.point), cos_cone - kSlack, reach + kSlack};
+  // Tiles whose blocks all match the plane are left out: the caller has those.
+  const Query matching{plane.normal, query.offset, cos_kappa_, epsilon_};
+  collect(query, &matching, ids);
+  for (const std::uint32_t id : undirected_) {
+    if (taken_[id] == 0 && std::abs(query.normal.dot(grid_.blocks()[id].point) + query.offset) < query.epsilon) {
+      ids.insert(id);
+    }
+  }
+  return ids.ascending();
+}
+
+// The untaken indexed blocks within the query's cone and slab, but for tiles wholly
+// inside `except`'s (when given).
+void PlaneScorer::collect(const Query& query, const Query* except, IdSet& ids) const {
   for (std::size_t b = 0; b < bins_.size(); ++b) {
+    const Node& bin = bins_[b];
+    if (bin.untaken == 0) continue;
     const Frame& frame = frames_[b];
     const Eigen::Vector3f frame_normal(std::abs(frame.a.dot(query.normal)), std::abs(frame.u.dot(query.normal)),
                                        std::abs(frame.v.dot(query.normal)));
-    const Node& bin = bins_[b];
-    if (bin.untaken == 0 || query.cone(bin) == Cone::Outside || query.slab(bin, frame_normal) == Slab::Outside) continue;
+    if (query.cone(bin) == Cone::Outside || query.slab(bin, frame_normal) == Slab::Outside) continue;
     for (std::uint32_t l = bin.begin; l < bin.end; ++l) {
       const Node& layer = layers_[l];
       if (layer.untaken == 0 || query.slab(layer, frame_normal) == Slab::Outside) continue;
@@ -341,16 +412,17 @@ std::vector<std::uint32_t> PlaneScorer::matching(const CandidatePlane& plane) co
         if (tile.untaken == 0 || query.slab(tile, frame_normal) == Slab::Outside) continue;
         const Cone cone = query.cone(tile);
         if (cone == Cone::Outside) continue;
+        if (except != nullptr && except->cone(tile) == Cone::Inside && except->slab(tile, frame_normal) == Slab::Inside) {
+          continue;
+        }
         for (std::uint32_t k = tile.begin; k < tile.end; ++k) {
           if (order_taken_[k] != 0) continue;
-          if (cone == Cone::Cut && std::abs(block_directions_[k].dot(query.normal)) < cos_kappa_) continue;
-          if (std::abs(query.normal.dot(points_[k]) + query.offset) < epsilon_) ids.push_back(ids_[k]);
+          if (cone == Cone::Cut && std::abs(block_directions_[k].dot(query.normal)) < query.cos_kappa) continue;
+          if (std::abs(query.normal.dot(points_[k]) + query.offset) < query.epsilon) ids.insert(ids_[k]);
         }
       }
     }
   }
-  std::sort(ids.begin(), ids.end());
-  return ids;
 }
 
 void PlaneScorer::take(const std::vector<std::uint32_t>& ids) {

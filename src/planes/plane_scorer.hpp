@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "mlmap/planes/block_grid.hpp"
+#include "id_set.hpp"
 #include "pca_sums.hpp"
 
 namespace mlmap {
@@ -35,13 +36,18 @@ struct PlaneScore {
 
 class PlaneScorer {
  public:
+  // `threads`: OpenMP threads for building the index, 0 = OpenMP's default.
   PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
-              double epsilon, double kappa_rad);
+              double epsilon, double kappa_rad, int threads = 0);
 
   PlaneScore score(const CandidatePlane& plane) const;
   // Ids of the untaken blocks matching the plane, ascending.
   std::vector<std::uint32_t> matching(const CandidatePlane& plane) const;
   bool matches(std::uint32_t id, const CandidatePlane& plane) const;
+  // Ids of the untaken blocks near the plane, ascending: within `reach` (m) of it, and
+  // with a direction within the cone of cosine `cos_cone` about its normal or none. A
+  // little wider than asked (float rounding): the caller applies its exact test.
+  std::vector<std::uint32_t> near(const CandidatePlane& plane, float cos_cone, float reach) const;
 
   // Takes the blocks out of the pool (an accepted plane's); the nodes' sums follow.
   void take(const std::vector<std::uint32_t>& ids);
@@ -69,6 +75,7 @@ class PlaneScorer {
   struct Query;
 
   void refresh(const std::vector<std::uint32_t>& tiles);
+  void collect(const Query& query, const Query* except, IdSet& ids) const;
 
   const BlockGrid& grid_;
   const std::vector<Eigen::Vector3f>& directions_;
@@ -90,6 +97,7 @@ class PlaneScorer {
   std::vector<std::uint32_t> tile_of_;              // array index -> tile
   std::vector<std::uint32_t> layer_of_tile_;
   std::vector<std::uint32_t> bin_of_layer_;
+  std::vector<std::uint32_t> undirected_;           // blocks without a direction (not in the index)
 };
 
 }  // namespace mlmap

@@ -10,6 +10,11 @@
 // `stack_gap` join, and the joined block is vertical only when it is deeper than
 // `level_band` (else it is level, at the inverse-variance mean of its members'
 // heights). The map itself is not changed; each eRMSM block names its map blocks.
+//
+// Blocks are numbered row by row over the grid (cells ascending in i, then j), not in
+// the map's cell order (the order the scans created them): neighbours in a Chebyshev
+// window are then a few runs of consecutive ids, and every per-block pass of eRMSM
+// streams through memory instead of jumping across it.
 #pragma once
 
 #include <Eigen/Core>
@@ -53,12 +58,19 @@ class BlockGrid {
   const std::vector<PlaneBlock>& blocks() const { return blocks_; }
   std::size_t size() const { return blocks_.size(); }
 
-  // Block ids of the map's cell number n are [firstBlockOfCell(n), firstBlockOfCell(n + 1));
-  // each names its map blocks in the cell (PlaneBlock::map_first, map_count).
+  // The grid's cells are numbered row by row (the map's cells, in another order): block
+  // ids of cell number n are [firstBlockOfCell(n), firstBlockOfCell(n + 1)), and each
+  // names its map blocks in the map's cell number mapCellOf(n) (PlaneBlock::map_first, map_count).
   std::uint32_t firstBlockOfCell(std::size_t cell_number) const { return cell_first_[cell_number]; }
-  std::size_t cellCount() const { return cell_first_.size() - 1; }
+  std::size_t mapCellOf(std::size_t cell_number) const { return map_cell_[cell_number]; }
+  std::size_t cellCount() const { return map_cell_.size(); }
+  // Block ids in the map's own cell order (the order its scans created the cells), each
+  // cell bottom to top: eRMSM draws its seeds from a list in this order, so its random
+  // draws do not depend on how the grid numbers the blocks.
+  std::vector<std::uint32_t> idsInMapOrder() const;
 
-  // Calls visit(block_id) for every block in cells within Chebyshev radius `radius` of `cell`.
+  // Calls visit(block_id) for every block in cells within Chebyshev radius `radius` of
+  // `cell`, row by row and in each cell bottom to top: ids ascending.
   template <typename Visit>
   void forEachNeighbour(CellIndex cell, int radius, Visit&& visit) const {
     const std::int64_t row_begin = std::max<std::int64_t>(cell.i - radius - min_i_, 0);
@@ -66,19 +78,25 @@ class BlockGrid {
     const std::int64_t column_begin = std::max<std::int64_t>(cell.j - radius - min_j_, 0);
     const std::int64_t column_end = std::min<std::int64_t>(cell.j + radius - min_j_, columns_ - 1);
     for (std::int64_t row = row_begin; row <= row_end; ++row) {
-      for (std::int64_t column = column_begin; column <= column_end; ++column) {
-        const std::int32_t number = grid_[static_cast<std::size_t>(row * columns_ + column)];
-        if (number < 0) continue;
-        for (std::uint32_t id = cell_first_[number]; id < cell_first_[number + 1]; ++id) visit(id);
-      }
+      // The row's cells in the window hold one run of consecutive ids: from the first
+      // occupied cell's first block to the last occupied cell's last.
+      const std::int32_t* line = grid_.data() + row * columns_;
+      std::int64_t first = column_begin;
+      while (first <= column_end && line[first] < 0) ++first;
+      if (first > column_end) continue;
+      std::int64_t last = column_end;
+      while (line[last] < 0) --last;
+      const std::uint32_t end = cell_first_[static_cast<std::size_t>(line[last]) + 1];
+      for (std::uint32_t id = cell_first_[static_cast<std::size_t>(line[first])]; id < end; ++id) visit(id);
     }
   }
 
  private:
   double cell_size_;
   std::vector<PlaneBlock> blocks_;
-  std::vector<std::uint32_t> cell_first_;  // per map cell number, plus one past the end
-  std::vector<std::int32_t> grid_;         // dense rows × columns of map cell numbers, −1 empty
+  std::vector<std::uint32_t> cell_first_;  // per cell number, plus one past the end
+  std::vector<std::uint32_t> map_cell_;    // per cell number: the map's number of that cell
+  std::vector<std::int32_t> grid_;         // dense rows × columns of cell numbers, −1 empty
   std::int64_t min_i_ = 0;
   std::int64_t min_j_ = 0;
   std::int64_t rows_ = 0;

@@ -47,6 +47,19 @@ struct ErmsmConfig {
   int threads = 0;                // OpenMP threads; 0 = OpenMP's default
 };
 
+// Seconds per stage of detectPlanes, for profiling: the first three make up
+// ErmsmStats::direction_seconds, the rest detection_seconds.
+struct ErmsmStageSeconds {
+  double noise = 0.0;       // the range-noise estimate, old labels cleared
+  double grid = 0.0;        // eRMSM blocks (BlockGrid)
+  double directions = 0.0;  // direction vectors
+  double index = 0.0;       // the scorer's index, the seedable blocks
+  double search = 0.0;      // Algorithm 1: draws, scores, refits, acceptance tests
+  double patches = 0.0;     // accepted planes: matching and edge blocks, patch split, outlines
+  double merges = 0.0;      // coplanar merges, classification, level merges
+  double labels = 0.0;      // labels written back into the map's blocks
+};
+
 struct ErmsmStats {
   std::size_t blocks = 0;
   std::size_t blocks_with_direction = 0;
@@ -56,6 +69,7 @@ struct ErmsmStats {
   std::size_t labelled_blocks = 0;
   double direction_seconds = 0.0;   // noise estimate, eRMSM blocks and direction vectors
   double detection_seconds = 0.0;   // Algorithm 1 with refits, patch split, merges, classes, labels
+  ErmsmStageSeconds stages;         // both, split further
 };
 
 struct PlaneDetection {

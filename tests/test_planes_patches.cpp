@@ -1,0 +1,259 @@
+// eRMSM internals for speed: the grid's row-by-row block numbering and its neighbour
+// runs, the patch split over raster column runs, outlines independent of block order,
+// and the counting sort — each against a plain reference.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <map>
+#include <numbers>
+#include <numeric>
+#include <random>
+#include <set>
+
+#include "../src/planes/counting_sort.hpp"
+#include "../src/planes/patch_rules.hpp"
+#include "../src/planes/plane_scorer.hpp"
+#include "mlmap/planes/block_grid.hpp"
+#include "mlmap/planes/direction_vectors.hpp"
+#include "mlmap/planes/patches.hpp"
+#include "plane_scenes.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+// Walls (vertical blocks), a floor with holes and a table: many patches on any plane.
+test::PlaneSceneBuilder patchScene() {
+  test::PlaneSceneBuilder scene(0.05, 0.005, 7);
+  scene.floor(0.0, 0.0, 1.2, 0.4, 0.0).floor(0.0, 0.6, 1.2, 1.0, 0.0).floor(0.5, 0.42, 0.55, 0.58, 0.0);
+  scene.floor(1.4, 0.2, 1.9, 0.7, 0.0).floor(0.3, 0.3, 0.8, 0.6, 0.72);
+  scene.wallX(0.02, 0.0, 1.0, 0.0, 1.2).wallY(1.01, 0.0, 0.7, 0.3, 1.5).wallY(1.03, 0.9, 1.6, 0.0, 0.8);
+  return scene;
+}
+
+// Connected components the slow way: every raster cell of every block (its point, and
+// for a vertical block points along its extent a cell apart), cells within gap_cells
+// (Chebyshev) connected; patches in the order of their first block, largest first.
+std::vector<std::vector<std::uint32_t>> referencePatches(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
+                                                         const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
+                                                         int gap_cells) {
+  Eigen::Vector3d u_axis;
+  Eigen::Vector3d v_axis;
+  planeBasis(normal, u_axis, v_axis);
+  const double cell = grid.cellSize();
+  auto cellOf = [&](const Eigen::Vector3d& p) {
+    return std::pair<int, int>(static_cast<int>(std::floor((p - point).dot(u_axis) / cell)),
+                               static_cast<int>(std::floor((p - point).dot(v_axis) / cell)));
+  };
+  std::map<std::pair<int, int>, std::size_t> cell_number;
+  std::vector<std::pair<int, int>> cells;
+  std::vector<std::size_t> first_cell(blocks.size());
+  auto add = [&](const std::pair<int, int>& c) {
+    const auto [it, fresh] = cell_number.emplace(c, cells.size());
+    if (fresh) cells.push_back(c);
+    return it->second;
+  };
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const PlaneBlock& block = grid.blocks()[blocks[k]];
+    const Eigen::Vector3d centre = block.point.cast<double>();
+    first_cell[k] = add(cellOf(centre));
+    if (!block.vertical) continue;
+    const double depth = block.top - block.bottom;
+    const int steps = std::max(1, static_cast<int>(std::ceil(depth / cell)));
+    for (int s = 0; s <= steps; ++s) add(cellOf({centre.x(), centre.y(), block.bottom + depth * s / steps}));
+  }
+  std::vector<std::size_t> component(cells.size());
+  std::iota(component.begin(), component.end(), std::size_t{0});
+  // Relabel until stable: each cell takes the smallest label within reach.
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::size_t a = 0; a < cells.size(); ++a) {
+      for (int du = -gap_cells; du <= gap_cells; ++du) {
+        for (int dv = -gap_cells; dv <= gap_cells; ++dv) {
+          const auto it = cell_number.find({cells[a].first + du, cells[a].second + dv});
+          if (it == cell_number.end() || component[it->second] <= component[a]) continue;
+          component[it->second] = component[a];
+          changed = true;
+        }
+      }
+    }
+  }
+  std::vector<std::vector<std::uint32_t>> patches;
+  std::vector<double> surfaces;
+  std::map<std::size_t, std::size_t> patch_of;
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const auto [it, fresh] = patch_of.emplace(component[first_cell[k]], patches.size());
+    if (fresh) {
+      patches.emplace_back();
+      surfaces.push_back(0.0);
+    }
+    patches[it->second].push_back(blocks[k]);
+    surfaces[it->second] += grid.blocks()[blocks[k]].surface;
+  }
+  std::vector<std::size_t> order(patches.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return surfaces[a] > surfaces[b]; });
+  std::vector<std::vector<std::uint32_t>> sorted;
+  for (const std::size_t k : order) sorted.push_back(patches[k]);
+  return sorted;
+}
+
+// withEdges the slow way: rings round the plane's blocks until none joins.
+std::vector<std::uint32_t> referenceEdges(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
+                                          const PlaneScorer& scorer, const std::vector<std::uint32_t>& matching,
+                                          const CandidatePlane& plane, double epsilon, double kappa) {
+  std::set<std::uint32_t> in_plane(matching.begin(), matching.end());
+  const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * kappa, std::numbers::pi / 2)));
+  std::vector<std::uint32_t> frontier = matching;
+  while (!frontier.empty()) {
+    std::vector<std::uint32_t> next;
+    for (const std::uint32_t id : frontier) {
+      grid.forEachNeighbour(grid.blocks()[id].cell, 1, [&](std::uint32_t other) {
+        if (in_plane.count(other) != 0 || scorer.taken(other)) return;
+        const Eigen::Vector3f& direction = directions[other];
+        if (direction.squaredNorm() > 0.0F && std::abs(direction.dot(plane.normal)) < cos_edge) return;
+        if (std::abs(plane.normal.dot(grid.blocks()[other].point - plane.point)) >= static_cast<float>(epsilon)) return;
+        in_plane.insert(other);
+        next.push_back(other);
+      });
+    }
+    frontier = std::move(next);
+  }
+  return {in_plane.begin(), in_plane.end()};
+}
+
+}  // namespace
+
+TEST_CASE("withEdges: the edge blocks found from the scorer's index equal rings grown round the plane, before and after takes") {
+  test::PlaneSceneBuilder scene = patchScene();
+  scene.rectangle({1.5, 0.9, 0.0}, {0.5, 0.0, 0.3}, {0.0, 0.5, 0.0}, 0.01);  // a ramp, its edges bent
+  const BlockGrid grid(scene.map());
+  DirectionConfig direction_config;
+  const std::vector<Eigen::Vector3f> directions = directionVectors(grid, direction_config);
+  const double epsilon = 0.05;
+  const double kappa = 25.0 * std::numbers::pi / 180.0;
+  PlaneScorer scorer(grid, directions, epsilon, kappa);
+  const std::vector<CandidatePlane> planes{{Eigen::Vector3f::UnitZ(), {0.0F, 0.0F, 0.0F}},
+                                           {Eigen::Vector3f::UnitZ(), {0.0F, 0.0F, 0.72F}},
+                                           {Eigen::Vector3f::UnitX(), {0.02F, 0.0F, 0.0F}},
+                                           {Eigen::Vector3f::UnitY(), {0.0F, 1.02F, 0.0F}},
+                                           {Eigen::Vector3f(-0.51F, 0.0F, 0.86F).normalized(), {1.5F, 0.9F, 0.0F}}};
+  std::size_t grown = 0;
+  for (int round = 0; round < 2; ++round) {
+    for (const CandidatePlane& plane : planes) {
+      const std::vector<std::uint32_t> matching = scorer.matching(plane);
+      const std::vector<std::uint32_t> edges = withEdges(grid, directions, scorer, matching, plane, epsilon, kappa);
+      CHECK(edges == referenceEdges(grid, directions, scorer, matching, plane, epsilon, kappa));
+      grown += edges.size() - matching.size();
+    }
+    scorer.take(scorer.matching(planes[0]));  // the floor leaves the pool
+  }
+  CHECK(grown > 0);
+}
+
+TEST_CASE("BlockGrid: blocks numbered row by row, a Chebyshev window's blocks visited in ascending ids, map order kept") {
+  test::PlaneSceneBuilder scene = patchScene();
+  const MLMap& map = scene.map();
+  const BlockGrid grid(map);
+  const auto& blocks = grid.blocks();
+  REQUIRE(grid.size() == map.blockCount());
+  for (std::uint32_t id = 1; id < grid.size(); ++id) {
+    const CellIndex a = blocks[id - 1].cell;
+    const CellIndex b = blocks[id].cell;
+    CHECK((a.i < b.i || (a.i == b.i && a.j < b.j) || (a.i == b.i && a.j == b.j && blocks[id - 1].top <= blocks[id].top)));
+  }
+  for (std::uint32_t id = 0; id < grid.size(); id += 7) {
+    for (const int radius : {1, 2, 4}) {
+      std::vector<std::uint32_t> visited;
+      grid.forEachNeighbour(blocks[id].cell, radius, [&](std::uint32_t other) { visited.push_back(other); });
+      std::vector<std::uint32_t> expected;
+      for (std::uint32_t other = 0; other < grid.size(); ++other) {
+        if (std::abs(blocks[other].cell.i - blocks[id].cell.i) <= radius &&
+            std::abs(blocks[other].cell.j - blocks[id].cell.j) <= radius) {
+          expected.push_back(other);
+        }
+      }
+      CHECK(visited == expected);
+    }
+  }
+  // Cell numbers map back to the map's cells, and idsInMapOrder lists the blocks by the map's cell numbers.
+  std::vector<std::uint32_t> in_map_order = grid.idsInMapOrder();
+  REQUIRE(in_map_order.size() == grid.size());
+  std::vector<std::size_t> map_cell_of_block(grid.size());
+  for (std::size_t n = 0; n < grid.cellCount(); ++n) {
+    const std::size_t map_cell = grid.mapCellOf(n);
+    CHECK(map.cellAt(map_cell) == blocks[grid.firstBlockOfCell(n)].cell);
+    for (std::uint32_t id = grid.firstBlockOfCell(n); id < grid.firstBlockOfCell(n + 1); ++id) map_cell_of_block[id] = map_cell;
+  }
+  for (std::size_t k = 1; k < in_map_order.size(); ++k) {
+    CHECK(map_cell_of_block[in_map_order[k - 1]] <= map_cell_of_block[in_map_order[k]]);
+  }
+  std::sort(in_map_order.begin(), in_map_order.end());
+  for (std::uint32_t id = 0; id < grid.size(); ++id) CHECK(in_map_order[id] == id);
+}
+
+TEST_CASE("splitIntoPatches: components over raster column runs equal cell-by-cell components") {
+  test::PlaneSceneBuilder scene = patchScene();
+  const BlockGrid grid(scene.map());
+  std::vector<std::uint32_t> all(grid.size());
+  std::iota(all.begin(), all.end(), std::uint32_t{0});
+  std::mt19937 random(3);
+  // A wall's plane (u level: a vertical block is one run), a floor's, and a plane tilted
+  // 10° (u not level: a vertical block is cells a cell apart); every block, and a sparse
+  // random tenth so that many small components form.
+  const std::vector<Eigen::Vector3d> normals{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(),
+                                            Eigen::Vector3d(std::sin(0.17), 0.0, std::cos(0.17))};
+  std::size_t most_patches = 0;
+  for (const Eigen::Vector3d& normal : normals) {
+    for (const bool sparse : {false, true}) {
+      std::vector<std::uint32_t> blocks;
+      for (const std::uint32_t id : all) {
+        if (!sparse || random() % 10 == 0) blocks.push_back(id);
+      }
+      for (const int gap : {1, 2}) {
+        const Eigen::Vector3d point(0.013, -0.021, 0.007);
+        const std::vector<Patch> patches = splitIntoPatches(grid, blocks, normal, point, gap);
+        const auto expected = referencePatches(grid, blocks, normal, point, gap);
+        REQUIRE(patches.size() == expected.size());
+        for (std::size_t k = 0; k < patches.size(); ++k) CHECK(patches[k].blocks == expected[k]);
+        most_patches = std::max(most_patches, patches.size());
+      }
+    }
+  }
+  CHECK(most_patches > 3);
+}
+
+TEST_CASE("outlineOf: the same outline whatever order the blocks are listed in") {
+  test::PlaneSceneBuilder scene(0.05, 0.0, 1);
+  // Two squares touching at a corner, and a ragged strip: loops meet at vertices.
+  scene.floor(0.0, 0.0, 0.48, 0.48, 0.0).floor(0.51, 0.51, 0.98, 0.98, 0.0);
+  for (int k = 0; k < 20; ++k) scene.floor(1.2 + 0.05 * k, 0.2 * (k % 3), 1.24 + 0.05 * k, 0.2 * (k % 3) + 0.3, 0.0);
+  const BlockGrid grid(scene.map());
+  std::vector<std::uint32_t> blocks(grid.size());
+  std::iota(blocks.begin(), blocks.end(), std::uint32_t{0});
+  const Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d point(0.0, 0.0, 0.0);
+  const std::vector<Eigen::Vector3d> outline = outlineOf(grid, blocks, normal, point);
+  REQUIRE(outline.size() >= 8);
+  std::mt19937 random(5);
+  for (int trial = 0; trial < 5; ++trial) {
+    std::shuffle(blocks.begin(), blocks.end(), random);
+    const std::vector<Eigen::Vector3d> shuffled = outlineOf(grid, blocks, normal, point);
+    REQUIRE(shuffled.size() == outline.size());
+    for (std::size_t k = 0; k < outline.size(); ++k) CHECK((shuffled[k] - outline[k]).norm() < 1e-12);
+  }
+}
+
+TEST_CASE("stableSortBy: a counting sort, or a stable sort for wide key ranges, equals std::stable_sort") {
+  std::mt19937 random(11);
+  for (const std::int64_t range : {std::int64_t{5}, std::int64_t{1000}, std::int64_t{1} << 40}) {
+    std::vector<std::pair<std::int64_t, std::uint32_t>> items(3000);
+    for (std::uint32_t k = 0; k < items.size(); ++k) {
+      items[k] = {static_cast<std::int64_t>(random() % static_cast<std::uint64_t>(range)) - range / 2, k};
+    }
+    auto expected = items;
+    std::stable_sort(expected.begin(), expected.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    stableSortBy(items, [](const auto& item) { return item.first; });
+    CHECK(items == expected);
+  }
+}
