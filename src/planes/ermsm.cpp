@@ -92,6 +92,7 @@ class Detector {
   std::int32_t accepted_ = 0;
   std::int32_t since_acceptance_ = 0;
   ErmsmStats* stats_ = nullptr;
+  std::vector<CandidatePlane> refused_;  // accepted planes that kept no patch, since blocks were last taken
 };
 
 // bestCandidate of Algorithm 1, lazily: a stale score is an upper bound (taking
@@ -130,9 +131,19 @@ void Detector::drop(std::size_t index) {
 // connected patches), and candidates seeded on them leave the list.
 bool Detector::accept(std::size_t index) {
   const Candidate accepted = candidates_[index];
+  // Candidates seeded apart often refit to the very same plane: one that kept nothing
+  // keeps nothing again until blocks are taken.
+  const auto same = [&](const CandidatePlane& plane) {
+    return plane.normal == accepted.plane.normal && plane.point == accepted.plane.point;
+  };
+  if (std::any_of(refused_.begin(), refused_.end(), same)) {
+    drop(index);
+    return false;
+  }
   const double kappa = radians(config_.kappa_deg);
   const std::vector<std::uint32_t> strict = scorer_.matching(accepted.plane);
   if (directionSpread(grid_, directions_, strict, accepted.plane) > config_.max_direction_spread_deg) {
+    refused_.push_back(accepted.plane);
     drop(index);
     return false;
   }
@@ -163,10 +174,12 @@ bool Detector::accept(std::size_t index) {
     patches_.planes.push_back(std::move(plane));
   }
   if (taken.empty()) {
+    refused_.push_back(accepted.plane);
     drop(index);
     return false;
   }
   scorer_.take(taken);
+  refused_.clear();
   std::vector<Candidate> remaining;
   for (Candidate& candidate : candidates_) {
     if (scorer_.taken(candidate.seeds[0]) || scorer_.taken(candidate.seeds[1]) || scorer_.taken(candidate.seeds[2])) {
