@@ -263,7 +263,7 @@ PatchSet Detector::run(ErmsmStats& stats) {
     }
   }
   stats.accepted = static_cast<std::size_t>(accepted_);
-  stats.stages.search = secondsSince(start) - stats.stages.patches;
+  stats.stages.search = std::max(0.0, secondsSince(start) - stats.stages.patches);
   const auto merge_start = Clock::now();
   // Block points sit at cell centres: pieces of one surface lie up to half a cell
   // further apart than ε allows a block.
