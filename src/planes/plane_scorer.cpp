@@ -23,6 +23,8 @@ constexpr int kElevationRows = 9;  // 10° each over [0°, 90°]; the top row is
 constexpr int kTileCells = 16;
 // Cones closer than this to κ are decided block by block (float rounding).
 constexpr float kCosMargin = 1e-5F;
+// Maps of fewer blocks build their index on one thread.
+constexpr std::size_t kParallelBlocks = 100000;
 
 // Azimuth columns per elevation row, so that bins cover similar solid angles; and the
 // first bin of every row.
@@ -101,11 +103,13 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   std::vector<std::int32_t> bin_of(grid.size(), -1);
   const auto count = static_cast<std::int64_t>(grid.size());
 #ifdef _OPENMP
-  const int team = threads > 0 ? threads : omp_get_max_threads();
+  // Small maps build their index on one thread: there a parallel region saves little,
+  // and on a shared machine it can wait milliseconds for a core.
+  const int team = grid.size() < kParallelBlocks ? 1 : threads > 0 ? threads : omp_get_max_threads();
 #else
   const int team = std::max(1, threads);  // the pragmas are ignored
 #endif
-#pragma omp parallel for schedule(static) num_threads(team)
+#pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
   for (std::int64_t id = 0; id < count; ++id) {
     const Eigen::Vector3f& d = directions[static_cast<std::size_t>(id)];
     if (d.squaredNorm() > 0.0F) bin_of[static_cast<std::size_t>(id)] = binOf(d);
@@ -199,7 +203,7 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   surfaces_.resize(order.size());
   half_depths_.resize(order.size());
   order_taken_.assign(order.size(), 0);
-#pragma omp parallel for schedule(static) num_threads(team)
+#pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
   for (std::int64_t k = 0; k < indexed; ++k) {
     const auto n = static_cast<std::size_t>(k);
     const std::uint32_t id = order[n].id;
@@ -234,13 +238,13 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   };
   // Each node on its own, so on all threads.
   const auto tile_count_signed = static_cast<std::int64_t>(tiles_.size());
-#pragma omp parallel for schedule(static) num_threads(team)
+#pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
   for (std::int64_t t = 0; t < tile_count_signed; ++t) {
     Node& tile = tiles_[static_cast<std::size_t>(t)];
     describe(tile, frames_[bin_of_layer_[layer_of_tile_[static_cast<std::size_t>(t)]]], tile.begin, tile.end);
   }
   const auto layer_count_signed = static_cast<std::int64_t>(layers_.size());
-#pragma omp parallel for schedule(dynamic, 16) num_threads(team)
+#pragma omp parallel for schedule(dynamic, 16) num_threads(team) if (team > 1)
   for (std::int64_t l = 0; l < layer_count_signed; ++l) {
     Node& layer = layers_[static_cast<std::size_t>(l)];
     describe(layer, frames_[bin_of_layer_[static_cast<std::size_t>(l)]], tiles_[layer.begin].begin, tiles_[layer.end - 1].end);
