@@ -92,6 +92,7 @@ class Detector {
   std::int32_t accepted_ = 0;
   std::int32_t since_acceptance_ = 0;
   ErmsmStats* stats_ = nullptr;
+  std::vector<CandidatePlane> refused_;  // accepted planes that kept no patch, since blocks were last taken
 };
 
 // bestCandidate of Algorithm 1, lazily: a stale score is an upper bound (taking
@@ -130,9 +131,19 @@ void Detector::drop(std::size_t index) {
 // connected patches), and candidates seeded on them leave the list.
 bool Detector::accept(std::size_t index) {
   const Candidate accepted = candidates_[index];
+  // Candidates seeded apart often refit to the very same plane: one that kept nothing
+  // keeps nothing again until blocks are taken.
+  const auto same = [&](const CandidatePlane& plane) {
+    return plane.normal == accepted.plane.normal && plane.point == accepted.plane.point;
+  };
+  if (std::any_of(refused_.begin(), refused_.end(), same)) {
+    drop(index);
+    return false;
+  }
   const double kappa = radians(config_.kappa_deg);
   const std::vector<std::uint32_t> strict = scorer_.matching(accepted.plane);
   if (directionSpread(grid_, directions_, strict, accepted.plane) > config_.max_direction_spread_deg) {
+    refused_.push_back(accepted.plane);
     drop(index);
     return false;
   }
@@ -163,10 +174,12 @@ bool Detector::accept(std::size_t index) {
     patches_.planes.push_back(std::move(plane));
   }
   if (taken.empty()) {
+    refused_.push_back(accepted.plane);
     drop(index);
     return false;
   }
   scorer_.take(taken);
+  refused_.clear();
   std::vector<Candidate> remaining;
   for (Candidate& candidate : candidates_) {
     if (scorer_.taken(candidate.seeds[0]) || scorer_.taken(candidate.seeds[1]) || scorer_.taken(candidate.seeds[2])) {
@@ -190,17 +203,33 @@ PatchSet Detector::run(ErmsmStats& stats) {
   const auto start = Clock::now();
   stats_ = &stats;
   const int batch = std::max(1, config_.batch_size);
+#ifdef _OPENMP
+  const int threads = config_.threads > 0 ? config_.threads : omp_get_max_threads();
+#endif
+  // Batches are drawn on several threads while that beats one: a batch takes well under
+  // a millisecond, and on a shared machine a parallel region can wait milliseconds for a
+  // core (the 10 cm corridor's search took 0.5 s at 2 threads instead of 0.011 s, and
+  // 0.02 s on one). Once a batch takes longer than its draws took added up, the rest are
+  // drawn on one thread. The candidates are the same either way.
+  bool parallel_draws = true;
+  std::vector<double> draw_seconds(static_cast<std::size_t>(batch));
   std::uint64_t generated = 0;
   int empty_batches = 0;
   while (generated < static_cast<std::uint64_t>(config_.max_candidates) && seedable_.size() - seedable_taken_ >= 3) {
     std::vector<CandidateDraw> draws(static_cast<std::size_t>(batch));
     const CandidateSource candidate_source = source();
-    // One thread: a batch takes well under a millisecond, and a parallel region per
-    // batch costs more than it saves on a shared machine — at 2 threads the search took
-    // 0.013 to 0.5 s on the 10 cm corridor, depending on what else ran; 0.02 s on one.
+    const auto batch_start = Clock::now();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (parallel_draws)
     for (int k = 0; k < batch; ++k) {
+      const auto draw_start = Clock::now();
       draws[static_cast<std::size_t>(k)] =
           drawCandidate(candidate_source, config_.seed, generated + static_cast<std::uint64_t>(k), candidates_);
+      draw_seconds[static_cast<std::size_t>(k)] = secondsSince(draw_start);
+    }
+    if (parallel_draws) {
+      double serial_seconds = 0.0;
+      for (const double seconds : draw_seconds) serial_seconds += seconds;
+      parallel_draws = secondsSince(batch_start) < serial_seconds;
     }
     generated += static_cast<std::uint64_t>(batch);
     bool any = false;
@@ -234,7 +263,7 @@ PatchSet Detector::run(ErmsmStats& stats) {
     }
   }
   stats.accepted = static_cast<std::size_t>(accepted_);
-  stats.stages.search = secondsSince(start) - stats.stages.patches;
+  stats.stages.search = std::max(0.0, secondsSince(start) - stats.stages.patches);
   const auto merge_start = Clock::now();
   // Block points sit at cell centres: pieces of one surface lie up to half a cell
   // further apart than ε allows a block.

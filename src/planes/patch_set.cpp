@@ -17,20 +17,25 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
   const std::vector<Plane>& planes = set.planes;
   const std::size_t count = planes.size();
   std::vector<Plane> merged;
+  std::vector<std::vector<std::uint32_t>> merged_blocks;
   std::vector<std::int32_t> new_id(count, 0);
   for (std::size_t k = 0; k < count; ++k) {
     if (roots[k] != k) continue;
     std::size_t members = 0;
     for (std::size_t member = 0; member < count; ++member) members += roots[member] == k ? 1 : 0;
     Plane plane;
+    Patch patch;
     if (members == 1) {
       plane = planes[k];  // alone: as it was
+      patch.blocks = std::move(set.blocks[k]);
     } else {
-      Patch patch;
+      // Each member's blocks are ascending: merged, not sorted again.
       for (std::size_t member = 0; member < count; ++member) {
-        if (roots[member] == k) patch.blocks.insert(patch.blocks.end(), set.blocks[member].begin(), set.blocks[member].end());
+        if (roots[member] != k) continue;
+        const auto middle = static_cast<std::ptrdiff_t>(patch.blocks.size());
+        patch.blocks.insert(patch.blocks.end(), set.blocks[member].begin(), set.blocks[member].end());
+        std::inplace_merge(patch.blocks.begin(), patch.blocks.begin() + middle, patch.blocks.end());
       }
-      std::sort(patch.blocks.begin(), patch.blocks.end());
       const Plane& largest = planes[k];
       const CandidatePlane reference{largest.normal.cast<float>(), largest.centroid.cast<float>()};
       for (const std::uint32_t id : patch.blocks) patch.surface += grid.blocks()[id].surface;
@@ -45,22 +50,7 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
       if (roots[member] == k) new_id[member] = plane.id;
     }
     merged.push_back(std::move(plane));
-  }
-  std::vector<std::vector<std::uint32_t>> merged_blocks(merged.size());
-  std::vector<std::size_t> members_of(merged.size(), 0);
-  for (std::size_t k = 0; k < count; ++k) {
-    const auto merged_index = static_cast<std::size_t>(new_id[k] - 1);
-    auto& blocks = merged_blocks[merged_index];
-    if (blocks.empty()) {
-      blocks = std::move(set.blocks[k]);
-    } else {
-      blocks.insert(blocks.end(), set.blocks[k].begin(), set.blocks[k].end());
-    }
-    ++members_of[merged_index];
-  }
-  // A plane alone keeps its ascending blocks.
-  for (std::size_t m = 0; m < merged.size(); ++m) {
-    if (members_of[m] > 1) std::sort(merged_blocks[m].begin(), merged_blocks[m].end());
+    merged_blocks.push_back(std::move(patch.blocks));
   }
   set.planes = std::move(merged);
   set.blocks = std::move(merged_blocks);

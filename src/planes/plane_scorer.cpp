@@ -23,6 +23,8 @@ constexpr int kElevationRows = 9;  // 10° each over [0°, 90°]; the top row is
 constexpr int kTileCells = 16;
 // Cones closer than this to κ are decided block by block (float rounding).
 constexpr float kCosMargin = 1e-5F;
+// Maps of fewer blocks build their index on one thread.
+constexpr std::size_t kParallelBlocks = 100000;
 
 // Azimuth columns per elevation row, so that bins cover similar solid angles; and the
 // first bin of every row.
@@ -101,9 +103,13 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   std::vector<std::int32_t> bin_of(grid.size(), -1);
   const auto count = static_cast<std::int64_t>(grid.size());
 #ifdef _OPENMP
-  const int team = threads > 0 ? threads : omp_get_max_threads();
+  // Small maps build their index on one thread: there a parallel region saves little,
+  // and on a shared machine it can wait milliseconds for a core.
+  const int team = grid.size() < kParallelBlocks ? 1 : threads > 0 ? threads : omp_get_max_threads();
+#else
+  const int team = std::max(1, threads);  // the pragmas are ignored
 #endif
-#pragma omp parallel for schedule(static) num_threads(team)
+#pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
   for (std::int64_t id = 0; id < count; ++id) {
     const Eigen::Vector3f& d = directions[static_cast<std::size_t>(id)];
     if (d.squaredNorm() > 0.0F) bin_of[static_cast<std::size_t>(id)] = binOf(d);
@@ -163,12 +169,6 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   bin_of_layer_.reserve(layer_count);
   tiles_.reserve(tile_count);
   layer_of_tile_.reserve(tile_count);
-  ids_.reserve(order.size());
-  points_.reserve(order.size());
-  block_directions_.reserve(order.size());
-  surfaces_.reserve(order.size());
-  half_depths_.reserve(order.size());
-  order_taken_.reserve(order.size());
   tile_of_.reserve(order.size());
   for (std::size_t k = 0; k < order.size(); ++k) {
     const Place& place = order[k];
@@ -186,21 +186,33 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
     }
     if (new_tile) {
       tiles_.emplace_back();
-      tiles_.back().begin = static_cast<std::uint32_t>(ids_.size());
+      tiles_.back().begin = static_cast<std::uint32_t>(k);
       layer_of_tile_.push_back(static_cast<std::uint32_t>(layers_.size() - 1));
     }
     bins_[static_cast<std::size_t>(bin)].end = static_cast<std::uint32_t>(layers_.size());
     layers_.back().end = static_cast<std::uint32_t>(tiles_.size());
-    position_[id] = static_cast<std::uint32_t>(ids_.size());
+    position_[id] = static_cast<std::uint32_t>(k);
     tile_of_.push_back(static_cast<std::uint32_t>(tiles_.size() - 1));
+    tiles_.back().end = static_cast<std::uint32_t>(k + 1);
+  }
+  // The blocks' data in index order: a gather across the grid, on all threads.
+  const auto indexed = static_cast<std::int64_t>(order.size());
+  ids_.resize(order.size());
+  points_.resize(order.size());
+  block_directions_.resize(order.size());
+  surfaces_.resize(order.size());
+  half_depths_.resize(order.size());
+  order_taken_.assign(order.size(), 0);
+#pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
+  for (std::int64_t k = 0; k < indexed; ++k) {
+    const auto n = static_cast<std::size_t>(k);
+    const std::uint32_t id = order[n].id;
     const PlaneBlock& block = grid.blocks()[id];
-    ids_.push_back(id);
-    points_.push_back(block.point);
-    block_directions_.push_back(directions[id]);
-    surfaces_.push_back(block.surface);
-    half_depths_.push_back(block.vertical ? 0.5F * (block.top - block.bottom) : 0.0F);
-    order_taken_.push_back(0);
-    tiles_.back().end = static_cast<std::uint32_t>(ids_.size());
+    ids_[n] = id;
+    points_[n] = block.point;
+    block_directions_[n] = directions[id];
+    surfaces_[n] = block.surface;
+    half_depths_[n] = block.vertical ? 0.5F * (block.top - block.bottom) : 0.0F;
   }
   // Every node's cone and box, from its blocks.
   auto describe = [&](Node& node, const Frame& frame, std::uint32_t begin, std::uint32_t end) {
@@ -224,28 +236,36 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
     // A little slack for the float rounding of the frame change.
     node.half_extent = 0.5F * (high - low) + Eigen::Vector3f::Constant(1e-5F);
   };
+  // Each node on its own, so on all threads.
+  const auto tile_count_signed = static_cast<std::int64_t>(tiles_.size());
+#pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
+  for (std::int64_t t = 0; t < tile_count_signed; ++t) {
+    Node& tile = tiles_[static_cast<std::size_t>(t)];
+    describe(tile, frames_[bin_of_layer_[layer_of_tile_[static_cast<std::size_t>(t)]]], tile.begin, tile.end);
+  }
+  const auto layer_count_signed = static_cast<std::int64_t>(layers_.size());
+#pragma omp parallel for schedule(dynamic, 16) num_threads(team) if (team > 1)
+  for (std::int64_t l = 0; l < layer_count_signed; ++l) {
+    Node& layer = layers_[static_cast<std::size_t>(l)];
+    describe(layer, frames_[bin_of_layer_[static_cast<std::size_t>(l)]], tiles_[layer.begin].begin, tiles_[layer.end - 1].end);
+  }
   for (std::size_t b = 0; b < bins; ++b) {
     Node& bin = bins_[b];
     if (bin.begin == bin.end) continue;
-    const std::uint32_t block_begin = tiles_[layers_[bin.begin].begin].begin;
-    const std::uint32_t block_end = tiles_[layers_[bin.end - 1].end - 1].end;
-    describe(bin, frames_[b], block_begin, block_end);
-    for (std::uint32_t l = bin.begin; l < bin.end; ++l) {
-      Node& layer = layers_[l];
-      describe(layer, frames_[b], tiles_[layer.begin].begin, tiles_[layer.end - 1].end);
-      for (std::uint32_t t = layer.begin; t < layer.end; ++t) describe(tiles_[t], frames_[b], tiles_[t].begin, tiles_[t].end);
-    }
+    describe(bin, frames_[b], tiles_[layers_[bin.begin].begin].begin, tiles_[layers_[bin.end - 1].end - 1].end);
   }
   std::vector<std::uint32_t> all_tiles(tiles_.size());
   for (std::uint32_t t = 0; t < tiles_.size(); ++t) all_tiles[t] = t;
-  refresh(all_tiles);
+  refresh(all_tiles, team);
 }
 
-// Recomputes the sums of the given tiles (ascending) and of their layers and bins.
-void PlaneScorer::refresh(const std::vector<std::uint32_t>& tiles) {
-  std::vector<std::uint32_t> layers;
-  for (const std::uint32_t t : tiles) {
-    Node& tile = tiles_[t];
+// Recomputes the sums of the given tiles (ascending) and of their layers and bins;
+// the tiles' on `threads` threads (each on its own).
+void PlaneScorer::refresh(const std::vector<std::uint32_t>& tiles, int threads) {
+  const auto tile_count = static_cast<std::int64_t>(tiles.size());
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  for (std::int64_t n = 0; n < tile_count; ++n) {
+    Node& tile = tiles_[tiles[static_cast<std::size_t>(n)]];
     tile.untaken = 0;
     tile.surface = 0.0;
     tile.pca = PcaSums{};
@@ -255,6 +275,9 @@ void PlaneScorer::refresh(const std::vector<std::uint32_t>& tiles) {
       tile.surface += surfaces_[k];
       tile.pca.addBlock((points_[k] - tile.centre).cast<double>(), half_depths_[k], surfaces_[k]);
     }
+  }
+  std::vector<std::uint32_t> layers;
+  for (const std::uint32_t t : tiles) {
     if (layers.empty() || layers.back() != layer_of_tile_[t]) layers.push_back(layer_of_tile_[t]);
   }
   std::vector<std::uint32_t> bins;
@@ -436,7 +459,7 @@ void PlaneScorer::take(const std::vector<std::uint32_t>& ids) {
   }
   std::sort(dirty.begin(), dirty.end());
   dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
-  refresh(dirty);
+  refresh(dirty, 1);
 }
 
 }  // namespace mlmap
