@@ -1,45 +1,43 @@
 #include "mlmap/registration/preprocessing.hpp"
 
 #include <cmath>
-#include <unordered_map>
 
 #include "mlmap/error.hpp"
+#include "mlmap/registration/voxel_table.hpp"
 
 namespace mlmap::registration {
 
 std::vector<Point> voxelDownSample(const std::vector<Point>& points, double voxel_size) {
   if (!(voxel_size > 0.0)) throw Error("voxel down-sampling: voxel size must be positive");
+  // The table numbers voxels in first-seen order: sums[index] is that voxel's running sum,
+  // so the output order does not depend on hashing.
   struct Sum {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     std::size_t count = 0;
-    std::size_t order = 0;
   };
-  // Integer voxel coordinates like OcTree keys, but without their ±32768 range limit.
-  struct Key {
-    long x, y, z;
-    bool operator==(const Key&) const = default;
-  };
-  struct KeyHash {
-    std::size_t operator()(const Key& key) const {
-      return static_cast<std::size_t>(key.x) * 73856093u ^ static_cast<std::size_t>(key.y) * 19349663u ^
-             static_cast<std::size_t>(key.z) * 83492791u;
-    }
-  };
-  const double factor = 1.0 / voxel_size;
-  std::unordered_map<Key, Sum, KeyHash> voxels;
-  voxels.reserve(points.size() / 4 + 1);
+  const double inverse_size = 1.0 / voxel_size;
+  VoxelTable table;
+  table.reserve(points.size() / 4 + 16);
+  std::vector<Sum> sums;
+  sums.reserve(points.size() / 4 + 16);
+  // Consecutive points of a scan mostly share a voxel: the last one's index saves a lookup.
+  VoxelKey last_key{};
+  std::uint32_t last_index = VoxelTable::kMissing;
   for (const Point& point : points) {
     if (!point.allFinite()) continue;
-    const Key key{static_cast<long>(std::floor(point.x() * factor)),
-                  static_cast<long>(std::floor(point.y() * factor)),
-                  static_cast<long>(std::floor(point.z() * factor))};
-    auto [it, inserted] = voxels.try_emplace(key);
-    if (inserted) it->second.order = voxels.size() - 1;
-    it->second.sum += point;
-    ++it->second.count;
+    const VoxelKey key = voxelKeyOf(point, inverse_size);
+    if (last_index == VoxelTable::kMissing || !(key == last_key)) {
+      const auto [index, inserted] = table.insert(key);
+      if (inserted) sums.emplace_back();
+      last_key = key;
+      last_index = index;
+    }
+    sums[last_index].sum += point;
+    ++sums[last_index].count;
   }
-  std::vector<Point> centroids(voxels.size());
-  for (const auto& [key, sum] : voxels) centroids[sum.order] = sum.sum / static_cast<double>(sum.count);
+  std::vector<Point> centroids;
+  centroids.reserve(sums.size());
+  for (const Sum& sum : sums) centroids.push_back(sum.sum / static_cast<double>(sum.count));
   return centroids;
 }
 
