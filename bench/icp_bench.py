@@ -8,16 +8,23 @@ odometry drift) this
      defaults: crop, down-sampling, target voxel hash + normals, ICP; reading excluded),
   3. runs the peers' icp_eval.py twice: with the peers' defaults (0.05 m voxels) and with
      `--voxel 0.1` (mlmap's source voxel size),
-and prints one table: per scene and method the median time per pair (down-sampling + normals or
-target structure + ICP, median over --runs), the median and maximum translation and rotation
-errors against poses_true.txt, and each peer's time over mlmap's.
+and prints one table: per scene and method the time per pair (down-sampling + normals or target
+structure + ICP, reading excluded), the median and maximum translation and rotation errors
+against poses_true.txt, and each peer's time over mlmap's.
+
+The machine is usually shared, so the methods run in --rounds interleaved rounds (mlmap, the
+peers at their defaults, the peers at 0.1 m, again, ...), one run per pair and round. Two time
+figures per method: the median over pairs of each pair's median over rounds (as icp_eval.py's
+own --runs median), and of each pair's minimum over rounds (the least disturbed run: what the
+code costs when it has the cores to itself). Errors are from the first round (every method is
+deterministic).
 
 Pairs and scoring are icp_eval.py's (source scan i+1, target scan i, start from the odometry
 relative pose; E = inv(T_true)·T_est); its scoring functions are imported, not re-implemented.
 
 Usage:
   bench/icp_bench.py [--build build] [--peers-build /tmp/build-peers]
-                     [--peers-dir ../shared/peers] [--runs 3] [--threads 2] [--work DIR]
+                     [--peers-dir ../shared/peers] [--rounds 5] [--threads 2] [--work DIR]
                      [--scenes maps/lab.json,maps/corridor.json] [--skip-peers]
 """
 import argparse, importlib.util, json, os, subprocess, sys, tempfile
@@ -41,24 +48,46 @@ def run(cmd, env):
     return p.stdout
 
 
-def score_mlmap(icp_eval, scene_dir, bench_json):
-    true = icp_eval.read_tum(os.path.join(scene_dir, "poses_true.txt"))
-    rows = []
-    for pair in bench_json["pairs"]:
-        i, j = pair["target"], pair["source"]
-        t_err, r_err = icp_eval.errors(np.linalg.inv(true[i]) @ true[j], np.array(pair["matrix"]))
-        rows.append(dict(pair=f"{i}-{j}", t_err_cm=t_err, r_err_deg=r_err, total_s=pair["seconds"]["total"],
-                         src_down=pair["points"]["source_down"], tgt_down=pair["points"]["target_down"]))
-    return rows
+def errors_of(icp_eval, true, i, j, matrix):
+    return icp_eval.errors(np.linalg.inv(true[i]) @ true[j], np.array(matrix))
 
 
-def summarise(rows):
-    t = [r["t_err_cm"] for r in rows]
-    a = [r["r_err_deg"] for r in rows]
-    s = [r["total_s"] for r in rows]
-    return dict(time=float(np.median(s)), t_med=float(np.median(t)), t_max=max(t), r_med=float(np.median(a)),
-                r_max=max(a), src=int(np.median([r["src_down"] for r in rows])),
-                tgt=int(np.median([r["tgt_down"] for r in rows])))
+def mlmap_round(icp_eval, true, bench_json):
+    """{pair: (total seconds, t err cm, rot err deg, source points, target points)}"""
+    out = {}
+    for p in bench_json["pairs"]:
+        i, j = p["target"], p["source"]
+        t_err, r_err = errors_of(icp_eval, true, i, j, p["matrix"])
+        out[f"{i}-{j}"] = (p["seconds"]["total"], t_err, r_err, p["points"]["source_down"],
+                           p["points"]["target_down"])
+    return out
+
+
+def peer_round(icp_eval, true, out_dir, peer):
+    out = {}
+    for name in sorted(os.listdir(out_dir)):
+        if not (name.startswith(peer + "_") and name.endswith(".json")):
+            continue
+        pair = name[len(peer) + 1:-5]
+        i, j = map(int, pair.split("-"))
+        res = json.load(open(os.path.join(out_dir, name)))[0]  # --runs 1: one result
+        t_err, r_err = errors_of(icp_eval, true, i, j, res["relative_pose"]["matrix"])
+        out[pair] = (res["seconds"]["total"], t_err, r_err, res["points"]["source_down"],
+                     res["points"]["target_down"])
+    return out
+
+
+def summarise(rounds):
+    """rounds: list of {pair: (seconds, t_err, r_err, src, tgt)}; errors from the first round."""
+    pairs = sorted(rounds[0], key=lambda p: tuple(map(int, p.split("-"))))
+    first = rounds[0]
+    per_pair = {p: [r[p][0] for r in rounds] for p in pairs}
+    t = [first[p][1] for p in pairs]
+    a = [first[p][2] for p in pairs]
+    return dict(time_median=float(np.median([np.median(v) for v in per_pair.values()])),
+                time_min=float(np.median([min(v) for v in per_pair.values()])),
+                t_med=float(np.median(t)), t_max=max(t), r_med=float(np.median(a)), r_max=max(a),
+                src=int(np.median([first[p][3] for p in pairs])), tgt=int(np.median([first[p][4] for p in pairs])))
 
 
 def main():
@@ -67,7 +96,7 @@ def main():
     ap.add_argument("--peers-build", default="/tmp/build-peers")
     ap.add_argument("--peers-dir", default=os.path.join(ROOT, "..", "shared", "peers"))
     ap.add_argument("--scenes", default="maps/lab.json,maps/corridor.json")
-    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--work", default="", help="keep the simulated scenes and JSON here")
     ap.add_argument("--skip-peers", action="store_true", help="mlmap only (while iterating)")
@@ -78,39 +107,48 @@ def main():
     work = a.work or tempfile.mkdtemp(prefix="icp_bench_")
     mlmap = os.path.join(a.build, "mlmap")
     bench = os.path.join(a.build, "mlmap_bench")
-    peer_settings = [("defaults (0.05 m voxels)", []), ("--voxel 0.1", ["--voxel", "0.1"])]
+    peer_settings = [("defaults (0.05 m voxels)", "default", []), ("--voxel 0.1", "voxel0.1", ["--voxel", "0.1"])]
+    peers = [] if a.skip_peers else ["open3d_icp", "pcl_icp"]
 
     table = []  # (scene, method, summary)
+    loads = []
     for scene_json in a.scenes.split(","):
         name = os.path.splitext(os.path.basename(scene_json))[0]
         scene_dir = os.path.join(work, name)
         if not os.path.exists(os.path.join(scene_dir, "poses_true.txt")):
             run([mlmap, "simulate", os.path.join(ROOT, scene_json), "-o", scene_dir], env)
-        out = json.loads(run([bench, "icp", scene_dir, "--runs", str(a.runs)], env))
-        json.dump(out, open(os.path.join(work, f"{name}_mlmap.json"), "w"), indent=1)
-        rows = score_mlmap(icp_eval, scene_dir, out)
-        table.append((name, "mlmap", summarise(rows)))
-        if a.skip_peers:
-            continue
-        for label, args in peer_settings:
-            out_dir = os.path.join(work, f"{name}_peers_{'default' if not args else 'voxel0.1'}")
-            run(["/usr/bin/python3", os.path.join(a.peers_dir, "icp_eval.py"), a.peers_build, scene_dir,
-                 "--runs", str(a.runs), "--out", out_dir, "--"] + args + ["--threads", str(a.threads)], env)
-            summary = json.load(open(os.path.join(out_dir, "summary.json")))["results"]
-            for peer in ("open3d_icp", "pcl_icp"):
-                table.append((name, f"{peer} {label}", summarise(summary[peer])))
+        true = icp_eval.read_tum(os.path.join(scene_dir, "poses_true.txt"))
+        rounds = {"mlmap": []}
+        for r in range(a.rounds):
+            loads.append(os.getloadavg()[0])
+            out = json.loads(run([bench, "icp", scene_dir, "--runs", "1"], env))
+            json.dump(out, open(os.path.join(work, f"{name}_mlmap_r{r}.json"), "w"), indent=1)
+            rounds["mlmap"].append(mlmap_round(icp_eval, true, out))
+            for label, tag, args in (peer_settings if peers else []):
+                out_dir = os.path.join(work, f"{name}_peers_{tag}_r{r}")
+                run(["/usr/bin/python3", os.path.join(a.peers_dir, "icp_eval.py"), a.peers_build, scene_dir,
+                     "--runs", "1", "--out", out_dir, "--"] + args + ["--threads", str(a.threads)], env)
+                for peer in peers:
+                    rounds.setdefault(f"{peer} {label}", []).append(peer_round(icp_eval, true, out_dir, peer))
+        for method, rs in rounds.items():
+            table.append((name, method, summarise(rs)))
 
-    print(f"threads: {a.threads}; runs: {a.runs} (median); load average: {os.getloadavg()[0]:.2f} (1 min)")
-    print("time = down-sampling + normals/target structure + ICP per pair, reading excluded")
+    print(f"threads: {a.threads}; rounds: {a.rounds}; load average (1 min) at the rounds: "
+          f"{min(loads):.2f}-{max(loads):.2f} on {os.cpu_count()} CPUs")
+    print("time per pair = down-sampling + normals/target structure + ICP, reading excluded;")
+    print("'median' = median over pairs of each pair's median over rounds, 'min' = ... of its minimum")
     print()
-    print("| scene | method | points src/tgt (down) | median s/pair | peer/mlmap | median t err cm | "
-          "max t err cm | median rot err deg | max rot err deg |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    mlmap_time = {scene: s["time"] for scene, method, s in table if method == "mlmap"}
+    print("| scene | method | points src/tgt (down) | s/pair median | s/pair min | peer/mlmap median | "
+          "peer/mlmap min | t err cm median | t err cm max | rot err deg median | rot err deg max |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    ref = {scene: s for scene, method, s in table if method == "mlmap"}
     for scene, method, s in table:
-        ratio = "1" if method == "mlmap" else f"{s['time'] / mlmap_time[scene]:.1f}x"
-        print(f"| {scene} | {method} | {s['src']}/{s['tgt']} | {s['time']:.3f} | {ratio} | {s['t_med']:.2f} | "
-              f"{s['t_max']:.2f} | {s['r_med']:.3f} | {s['r_max']:.3f} |")
+        r = ref[scene]
+        ratio_med = "1" if method == "mlmap" else f"{s['time_median'] / r['time_median']:.1f}x"
+        ratio_min = "1" if method == "mlmap" else f"{s['time_min'] / r['time_min']:.1f}x"
+        print(f"| {scene} | {method} | {s['src']}/{s['tgt']} | {s['time_median']:.3f} | {s['time_min']:.3f} | "
+              f"{ratio_med} | {ratio_min} | {s['t_med']:.2f} | {s['t_max']:.2f} | {s['r_med']:.3f} | "
+              f"{s['r_max']:.3f} |")
     print(f"\n(work directory: {work})")
 
 

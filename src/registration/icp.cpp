@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 namespace mlmap::registration {
@@ -25,7 +26,17 @@ constexpr double kCoarseKernelDivisor = 6.0;
 constexpr double kCoarseEigenvalueFactor = 2.0;
 // Correspondences are kept, not searched again, after an iteration that moved points less
 // than this fraction of the smallest kernel scale (the range noise).
-constexpr double kReuseMotion = 0.1;
+constexpr double kReuseMotion = 0.2;
+// Points that found no partner within the gate are not searched again while points have
+// moved less than this fraction of the gate since (the gate never widens).
+constexpr double kMissMotion = 0.25;
+
+// How a pass finds its correspondences.
+enum class Search {
+  All,         // every sampled point searches the map
+  SkipMisses,  // ... except those that found nothing at the last search
+  Reuse,       // no search: the last matches stand, residuals are evaluated again
+};
 
 struct LinearSystem {
   Matrix6d hessian = Matrix6d::Zero();
@@ -38,11 +49,13 @@ struct LinearSystem {
 };
 
 // What one pass over the source yields: the normal equations and, per point, its match
-// and the magnitude of its residual (negative: no correspondence), from which the gate adapts.
+// and the magnitude of its residual (negative: no correspondence), from which the gate
+// adapts; whether its last search found nothing.
 struct Pass {
   LinearSystem system;
   std::vector<double> residuals;
   std::vector<Neighbour> matches;
+  std::vector<char> missed;
 };
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
@@ -83,20 +96,20 @@ double addTerm(const Point& source, const Neighbour& target, IcpMetric metric, d
 // Transform, associate and build the normal equations in one parallel pass over every
 // `stride`-th source point (one fork-join per iteration: on a busy machine each join waits
 // for the slowest thread's time slice). With point-to-plane, map points without a normal
-// give no correspondence. With `reuse`, the last pass's matches stand and only the
-// residuals are evaluated again: once the pose moves by a fraction of a millimetre per
-// iteration, the nearest map point, and surely its voxel's plane, stays the same.
+// give no correspondence. Search::Reuse keeps the last matches: once the pose moves by a
+// millimetre per iteration the nearest map point, and surely its voxel's plane, stays.
 // Partial sums over fixed blocks, added in block order: the same result at any thread count.
 void associateAndBuild(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& pose,
-                       double gate, IcpMetric metric, long stride, bool reuse, double scale,
+                       double gate, IcpMetric metric, long stride, Search search, double scale,
                        const Eigen::Vector3d& pivot, Pass& pass) {
   const double scale_sq = scale * scale;
   const std::size_t blocks = (source.size() + kBlockSize - 1) / kBlockSize;
   std::vector<LinearSystem> partial(blocks);
-  if (!reuse) {
-    pass.residuals.assign(source.size(), -1.0);
-    pass.matches.resize(source.size());
-  }
+  pass.matches.resize(source.size());
+  pass.missed.resize(source.size(), 0);
+  // Reuse keeps the last residual signs: a point without a match stays without one.
+  std::vector<double> last = std::move(pass.residuals);
+  pass.residuals.assign(source.size(), -1.0);
 #pragma omp parallel for schedule(dynamic, 4)
   for (long b = 0; b < static_cast<long>(blocks); ++b) {
     LinearSystem& system = partial[static_cast<std::size_t>(b)];
@@ -104,10 +117,12 @@ void associateAndBuild(const std::vector<Point>& source, const VoxelHashMap& tar
     const std::size_t end = std::min(source.size(), begin + kBlockSize);
     const std::size_t stride_size = static_cast<std::size_t>(stride);
     for (std::size_t i = (begin + stride_size - 1) / stride_size * stride_size; i < end; i += stride_size) {
-      if (reuse && pass.residuals[i] < 0.0) continue;
+      if (search == Search::Reuse && !(i < last.size() && last[i] >= 0.0)) continue;
+      if (search == Search::SkipMisses && pass.missed[i] != 0) continue;
       const Point moved = pose * source[i];
-      if (!reuse) {
+      if (search != Search::Reuse) {
         const std::optional<Neighbour> neighbour = target.nearest(moved, gate);
+        pass.missed[i] = neighbour ? 0 : 1;
         if (!neighbour || (metric == IcpMetric::PointToPlane && neighbour->normal.isZero())) continue;
         pass.matches[i] = *neighbour;
       }
@@ -203,6 +218,7 @@ IcpResult alignPoints(const std::vector<Point>& source, const VoxelHashMap& targ
   bool coarse = true;
   int coarse_iterations = 0;
   bool reuse = false;
+  double moved_since_search = std::numeric_limits<double>::infinity();  // m, since the last Search::All
   LinearSystem system;
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
     const long stride = coarse ? coarseStride(source.size()) : 1;
@@ -211,13 +227,22 @@ IcpResult alignPoints(const std::vector<Point>& source, const VoxelHashMap& targ
     // coarse stage the gate is wide to reach far partners, and a tighter kernel keeps the
     // mismatches it admits from steering.
     result.kernel_scale = std::max(config.min_kernel_scale, gate / (coarse ? kCoarseKernelDivisor : 3.0));
-    associateAndBuild(source, target, result.pose, gate, config.metric, stride, reuse, result.kernel_scale,
+    Search search = Search::All;
+    if (reuse) {
+      search = Search::Reuse;
+    } else if (moved_since_search < kMissMotion * gate) {
+      search = Search::SkipMisses;
+    } else {
+      moved_since_search = 0.0;
+    }
+    associateAndBuild(source, target, result.pose, gate, config.metric, stride, search, result.kernel_scale,
                       result.pivot, pass);
     const double spread = residualSpread(pass.residuals, result.inliers, result.rms_residual);
     result.iterations = iteration + 1;
     if (result.inliers < 6) {
       if (coarse) {  // too few sampled points matched: let every point try
         coarse = false;
+        moved_since_search = std::numeric_limits<double>::infinity();
         continue;
       }
       break;
@@ -232,6 +257,7 @@ IcpResult alignPoints(const std::vector<Point>& source, const VoxelHashMap& targ
     const double step_translation = step.tail<3>().norm();
     const double step_rotation = step.head<3>().norm();
     const double motion = step_translation + step_rotation * radius;
+    moved_since_search += motion;
     // The adaptive threshold: the gate follows the residual spread plus how far points
     // just moved, so it stays wide while the pose still travels and closes in once it
     // settles (never below min_max_distance).
