@@ -69,9 +69,9 @@ PairRun registerPair(const std::vector<Point>& source, const std::vector<Point>&
   const double cpu_start = processCpuSeconds();
   auto start = Clock::now();
   const std::vector<Point> target_dense =
-      voxelDownSample(cropRange(target, config.min_range, config.max_range), config.map_voxel_size / 2.0);
+      voxelDownSample(target, config.map_voxel_size / 2.0, config.min_range, config.max_range);
   const std::vector<Point> source_sample =
-      voxelDownSample(cropRange(source, config.min_range, config.max_range), config.source_voxel_size);
+      voxelDownSample(source, config.source_voxel_size, config.min_range, config.max_range);
   run.times.downsample = secondsSince(start);
 
   start = Clock::now();

@@ -19,7 +19,8 @@ bool inKeyRange(const VoxelKey& key) {
          key.z <= kKeyMax;
 }
 
-// The PCA normal of a neighbourhood's moments about `reference`, or zero when it is not planar.
+// The PCA normal of a neighbourhood from its moments (about any nearby point), or zero when it
+// is not planar.
 Normal planeNormal(std::size_t count, const Eigen::Vector3d& sum, const Eigen::Matrix3d& outer,
                    const NormalConfig& config) {
   if (count < config.min_neighbours) return Normal::Zero();
