@@ -15,6 +15,7 @@ namespace {
 
 constexpr double kMadToSigma = 1.4826;  // MAD -> standard deviation of a Gaussian
 constexpr std::size_t kBlockSize = 512; // points per partial sum of the reduction
+constexpr std::size_t kParallelSearches = 4000;  // fewer searches in a pass: one thread
 // The coarse stage: about this many source points, at most this many iterations, until
 // points move less than this fraction of the smallest gate in one iteration; its kernel
 // scale is the gate over this divisor, and directions whose eigenvalue ratio is below this
@@ -110,7 +111,11 @@ void associateAndBuild(const std::vector<Point>& source, const VoxelHashMap& tar
   // Reuse keeps the last residual signs: a point without a match stays without one.
   std::vector<double> last = std::move(pass.residuals);
   pass.residuals.assign(source.size(), -1.0);
-#pragma omp parallel for schedule(dynamic, 4)
+  // A pass that searches few points (the coarse stage) or none (reuse) takes a millisecond
+  // or two: alone it beats paying a fork-join, which on a busy machine can wait out another
+  // job's time slice.
+  const std::size_t searched = search == Search::Reuse ? 0 : source.size() / static_cast<std::size_t>(stride);
+#pragma omp parallel for schedule(dynamic, 4) if (searched >= kParallelSearches)
   for (long b = 0; b < static_cast<long>(blocks); ++b) {
     LinearSystem& system = partial[static_cast<std::size_t>(b)];
     const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
