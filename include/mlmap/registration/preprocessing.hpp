@@ -10,9 +10,9 @@
 namespace mlmap::registration {
 
 // The centroid of the points in each voxel of size `voxel_size` (OcTree keys), ordered
-// by each voxel's first point, so the result does not depend on hashing (nor on the thread
-// count). Only the points whose distance from the sensor origin lies in [min_range,
-// max_range] count: cropRange without the copy.
+// by each voxel's first point, so the result does not depend on hashing. Only the points
+// whose distance from the sensor origin lies in [min_range, max_range] count: cropRange
+// without the copy.
 std::vector<Point> voxelDownSample(const std::vector<Point>& points, double voxel_size, double min_range = 0.0,
                                    double max_range = std::numeric_limits<double>::infinity());
 
