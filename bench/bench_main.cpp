@@ -1,5 +1,6 @@
 // mlmap_bench: the speed and size figures of the README, printed, never asserted.
 //   mlmap_bench [SCENE.json] [--quick]
+//   mlmap_bench icp SCENE_DIR [--runs N]   (pairwise ICP, see icp_pairs.cpp)
 // Simulates the scene (default maps/lab.json), then times insertion into the block
 // layer alone and the OcTree alone on the same points, and reports map sizes at
 // several cell sizes.
@@ -11,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include "icp_pairs.hpp"
 #include "mlmap/map/map.hpp"
 #include "mlmap/sim/scene.hpp"
 #include "mlmap/sim/simulator.hpp"
@@ -48,13 +50,21 @@ int threadCount() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::strcmp(argv[1], "icp") == 0) {
+    try {
+      return mlmap::bench::runIcpPairs(argc - 1, argv + 1);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "mlmap_bench icp: %s\n", error.what());
+      return 1;
+    }
+  }
   std::string scene_path = std::string(MLMAP_SOURCE_DIR) + "/maps/lab.json";
   bool quick = false;
   for (int k = 1; k < argc; ++k) {
     if (std::strcmp(argv[k], "--quick") == 0) {
       quick = true;
     } else if (std::strcmp(argv[k], "--help") == 0 || std::strcmp(argv[k], "-h") == 0) {
-      std::printf("usage: mlmap_bench [SCENE.json] [--quick]\n");
+      std::printf("usage: mlmap_bench [SCENE.json] [--quick]\n       mlmap_bench icp SCENE_DIR [--runs 3]\n");
       return 0;
     } else {
       scene_path = argv[k];

@@ -122,3 +122,36 @@ TEST_CASE("VoxelHashMap: normals of a plane, none on a line") {
   REQUIRE(on_line);
   CHECK(on_line->normal.isZero());
 }
+
+TEST_CASE("VoxelHashMap: normals after adding points match a map built at once") {
+  // A curved floor and a wall added in two halves: the voxels along the seam get new
+  // neighbours from the second half, so their normals must be estimated again.
+  std::vector<Point> first, second;
+  for (double x = 0.0; x < 1.0; x += 0.02) {
+    for (double y = 0.0; y < 1.0; y += 0.02) {
+      (x < 0.5 ? first : second).emplace_back(x, y, 0.3 * x * x + 0.1 * y);  // curved: normals depend on the neighbourhood
+      (y < 0.5 ? first : second).emplace_back(1.0, y, x);
+    }
+  }
+  VoxelHashMap incremental(0.1, 1000);  // no cap: both maps keep every point
+  incremental.addPoints(first);
+  incremental.estimateNormals();
+  incremental.addPoints(second);
+  incremental.estimateNormals();
+  std::vector<Point> all = first;
+  all.insert(all.end(), second.begin(), second.end());
+  VoxelHashMap at_once(0.1, 1000);
+  at_once.addPoints(all);
+  at_once.estimateNormals();
+  REQUIRE(incremental.size() == at_once.size());
+  int with_normal = 0;
+  for (const Point& point : all) {
+    const auto a = incremental.nearest(point, 0.01);
+    const auto b = at_once.nearest(point, 0.01);
+    REQUIRE(a);
+    REQUIRE(b);
+    CHECK((a->normal - b->normal).norm() < 1e-9);
+    with_normal += a->normal.isZero() ? 0 : 1;
+  }
+  CHECK(with_normal > static_cast<int>(all.size()) * 8 / 10);
+}

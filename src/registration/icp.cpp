@@ -1,23 +1,42 @@
-// The ICP loop as a few named steps (transform + associate, adapt the kernel, build the
-// normal equations, solve, update, converged?), like KISS-ICP's Registration.cpp.
+// The ICP loop as a few named steps (transform + associate + build the normal equations in
+// one pass, adapt the gate, solve, update, converged?), like KISS-ICP's Registration.cpp,
+// in two stages: a sparse coarse stage at the wide initial gate, then every point.
 #include "mlmap/registration/icp.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 
 namespace mlmap::registration {
 namespace {
 
 constexpr double kMadToSigma = 1.4826;  // MAD -> standard deviation of a Gaussian
 constexpr std::size_t kBlockSize = 512; // points per partial sum of the reduction
+constexpr std::size_t kParallelSearches = 4000;  // fewer searches in a pass: one thread
+// The coarse stage: about this many source points, at most this many iterations, until
+// points move less than this fraction of the smallest gate in one iteration; its kernel
+// scale is the gate over this divisor, and directions whose eigenvalue ratio is below this
+// factor times the degeneracy threshold stay put.
+constexpr std::size_t kCoarsePoints = 1500;
+constexpr int kMaxCoarseIterations = 20;
+constexpr double kCoarseSettledMotion = 0.05;
+constexpr double kCoarseKernelDivisor = 6.0;
+constexpr double kCoarseEigenvalueFactor = 2.0;
+// Correspondences are kept, not searched again, after an iteration that moved points less
+// than this fraction of the smallest kernel scale (the range noise).
+constexpr double kReuseMotion = 0.2;
+// Points that found no partner within the gate are not searched again while points have
+// moved less than this fraction of the gate since (the gate never widens).
+constexpr double kMissMotion = 0.25;
 
-struct Correspondence {
-  Point source;  // transformed into the target frame
-  Point target;
-  Normal normal;
-  bool valid = false;
+// How a pass finds its correspondences.
+enum class Search {
+  All,         // every sampled point searches the map
+  SkipMisses,  // ... except those that found nothing at the last search
+  Reuse,       // no search: the last matches stand, residuals are evaluated again
 };
 
 struct LinearSystem {
@@ -30,46 +49,105 @@ struct LinearSystem {
   }
 };
 
+// What one pass over the source yields: the normal equations and, per point, its match
+// and the magnitude of its residual (negative: no correspondence), from which the gate
+// adapts; whether its last search found nothing.
+struct Pass {
+  LinearSystem system;
+  std::vector<double> residuals;
+  std::vector<Neighbour> matches;
+  std::vector<char> missed;
+};
+
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
   m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
   return m;
 }
 
-// Every `stride`-th source point gets a correspondence; the others are marked invalid.
-void associate(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& pose,
-               double gate, IcpMetric metric, long stride, std::vector<Correspondence>& correspondences) {
-  const long count = static_cast<long>(source.size());
-#pragma omp parallel for schedule(dynamic, 1024)
-  for (long i = 0; i < count; ++i) {
-    Correspondence& c = correspondences[static_cast<std::size_t>(i)];
-    c.valid = false;
-    if (i % stride != 0) continue;
-    c.source = pose * source[static_cast<std::size_t>(i)];
-    const auto neighbour = target.nearest(c.source, gate);
-    c.valid = neighbour && (metric == IcpMetric::PointToPoint || !neighbour->normal.isZero());
-    if (!c.valid) continue;
-    c.target = neighbour->point;
-    c.normal = neighbour->normal;
-  }
+long coarseStride(std::size_t points) {
+  return std::max(1L, static_cast<long>(points / kCoarsePoints));
 }
 
-double residualNorm(const Correspondence& c, IcpMetric metric) {
-  return metric == IcpMetric::PointToPlane ? std::abs(c.normal.dot(c.source - c.target))
-                                           : (c.source - c.target).norm();
+// Adds one correspondence's Geman–McClure weighted term to Σ w·JᵀJ and Σ w·Jᵀr, for the
+// increment (ω about `pivot`, v); returns the residual's magnitude.
+double addTerm(const Point& source, const Neighbour& target, IcpMetric metric, double scale_sq,
+               const Eigen::Vector3d& pivot, LinearSystem& system) {
+  const Eigen::Vector3d arm = source - pivot;
+  if (metric == IcpMetric::PointToPlane) {
+    const double residual = target.normal.dot(source - target.point);
+    Vector6d jacobian;
+    jacobian << arm.cross(target.normal), target.normal;
+    const double root = scale_sq / (scale_sq + residual * residual);
+    const double weight = root * root;
+    system.hessian.noalias() += weight * jacobian * jacobian.transpose();
+    system.gradient.noalias() += weight * residual * jacobian;
+    return std::abs(residual);
+  }
+  const Eigen::Vector3d residual = source - target.point;
+  Eigen::Matrix<double, 3, 6> jacobian;
+  jacobian << -skew(arm), Eigen::Matrix3d::Identity();
+  const double root = scale_sq / (scale_sq + residual.squaredNorm());
+  const double weight = root * root;
+  system.hessian.noalias() += weight * jacobian.transpose() * jacobian;
+  system.gradient.noalias() += weight * jacobian.transpose() * residual;
+  return residual.norm();
+}
+
+// Transform, associate and build the normal equations in one parallel pass over every
+// `stride`-th source point (one fork-join per iteration: on a busy machine each join waits
+// for the slowest thread's time slice). With point-to-plane, map points without a normal
+// give no correspondence. Search::Reuse keeps the last matches: once the pose moves by a
+// millimetre per iteration the nearest map point, and surely its voxel's plane, stays.
+// Partial sums over fixed blocks, added in block order: the same result at any thread count.
+void associateAndBuild(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& pose,
+                       double gate, IcpMetric metric, long stride, Search search, double scale,
+                       const Eigen::Vector3d& pivot, Pass& pass) {
+  const double scale_sq = scale * scale;
+  const std::size_t blocks = (source.size() + kBlockSize - 1) / kBlockSize;
+  std::vector<LinearSystem> partial(blocks);
+  pass.matches.resize(source.size());
+  pass.missed.resize(source.size(), 0);
+  // Reuse keeps the last residual signs: a point without a match stays without one.
+  std::vector<double> last = std::move(pass.residuals);
+  pass.residuals.assign(source.size(), -1.0);
+  // A pass that searches few points (the coarse stage) or none (reuse) takes a millisecond
+  // or two: alone it beats paying a fork-join, which on a busy machine can wait out another
+  // job's time slice.
+  const std::size_t searched = search == Search::Reuse ? 0 : source.size() / static_cast<std::size_t>(stride);
+#pragma omp parallel for schedule(dynamic, 4) if (searched >= kParallelSearches)
+  for (long b = 0; b < static_cast<long>(blocks); ++b) {
+    LinearSystem& system = partial[static_cast<std::size_t>(b)];
+    const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
+    const std::size_t end = std::min(source.size(), begin + kBlockSize);
+    const std::size_t stride_size = static_cast<std::size_t>(stride);
+    for (std::size_t i = (begin + stride_size - 1) / stride_size * stride_size; i < end; i += stride_size) {
+      if (search == Search::Reuse && !(i < last.size() && last[i] >= 0.0)) continue;
+      if (search == Search::SkipMisses && pass.missed[i] != 0) continue;
+      const Point moved = pose * source[i];
+      if (search != Search::Reuse) {
+        const std::optional<Neighbour> neighbour = target.nearest(moved, gate);
+        pass.missed[i] = neighbour ? 0 : 1;
+        if (!neighbour || (metric == IcpMetric::PointToPlane && neighbour->normal.isZero())) continue;
+        pass.matches[i] = *neighbour;
+      }
+      pass.residuals[i] = addTerm(moved, pass.matches[i], metric, scale_sq, pivot, system);
+    }
+  }
+  pass.system = LinearSystem{};
+  for (const LinearSystem& system : partial) pass.system += system;
 }
 
 // The robust spread of the residuals (their median absolute value as a sigma), with the
 // number of correspondences and their RMS residual.
-double residualSpread(const std::vector<Correspondence>& correspondences, IcpMetric metric,
-                      std::size_t& inliers, double& rms) {
+double residualSpread(const std::vector<double>& residuals, std::size_t& inliers, double& rms) {
   std::vector<double> magnitudes;
-  magnitudes.reserve(correspondences.size());
+  magnitudes.reserve(residuals.size());
   double sum_sq = 0.0;
-  for (const Correspondence& c : correspondences) {
-    if (!c.valid) continue;
-    magnitudes.push_back(residualNorm(c, metric));
-    sum_sq += magnitudes.back() * magnitudes.back();
+  for (const double residual : residuals) {
+    if (residual < 0.0) continue;
+    magnitudes.push_back(residual);
+    sum_sq += residual * residual;
   }
   inliers = magnitudes.size();
   rms = inliers > 0 ? std::sqrt(sum_sq / static_cast<double>(inliers)) : 0.0;
@@ -77,43 +155,6 @@ double residualSpread(const std::vector<Correspondence>& correspondences, IcpMet
   auto middle = magnitudes.begin() + static_cast<long>(magnitudes.size() / 2);
   std::nth_element(magnitudes.begin(), middle, magnitudes.end());
   return kMadToSigma * *middle;
-}
-
-// Σ w·JᵀJ and Σ w·Jᵀr for the increment (ω about `pivot`, v), Geman–McClure weights.
-// Partial sums over fixed blocks, added in block order: the same result at any thread count.
-LinearSystem buildSystem(const std::vector<Correspondence>& correspondences, IcpMetric metric,
-                         double scale, const Eigen::Vector3d& pivot) {
-  const double scale_sq = scale * scale;
-  const std::size_t blocks = (correspondences.size() + kBlockSize - 1) / kBlockSize;
-  std::vector<LinearSystem> partial(blocks);
-#pragma omp parallel for schedule(static)
-  for (long b = 0; b < static_cast<long>(blocks); ++b) {
-    LinearSystem& system = partial[static_cast<std::size_t>(b)];
-    const std::size_t end = std::min(correspondences.size(), (static_cast<std::size_t>(b) + 1) * kBlockSize);
-    for (std::size_t i = static_cast<std::size_t>(b) * kBlockSize; i < end; ++i) {
-      const Correspondence& c = correspondences[i];
-      if (!c.valid) continue;
-      const Eigen::Vector3d arm = c.source - pivot;
-      if (metric == IcpMetric::PointToPlane) {
-        const double residual = c.normal.dot(c.source - c.target);
-        Vector6d jacobian;
-        jacobian << arm.cross(c.normal), c.normal;
-        const double weight = std::pow(scale_sq / (scale_sq + residual * residual), 2);
-        system.hessian.noalias() += weight * jacobian * jacobian.transpose();
-        system.gradient.noalias() += weight * residual * jacobian;
-      } else {
-        const Eigen::Vector3d residual = c.source - c.target;
-        Eigen::Matrix<double, 3, 6> jacobian;
-        jacobian << -skew(arm), Eigen::Matrix3d::Identity();
-        const double weight = std::pow(scale_sq / (scale_sq + residual.squaredNorm()), 2);
-        system.hessian.noalias() += weight * jacobian.transpose() * jacobian;
-        system.gradient.noalias() += weight * jacobian.transpose() * residual;
-      }
-    }
-  }
-  LinearSystem total;
-  for (const LinearSystem& system : partial) total += system;
-  return total;
 }
 
 // Solves H·δ = −g in the eigenbasis of H with rotations scaled to metres at `radius`;
@@ -173,33 +214,70 @@ IcpResult alignPoints(const std::vector<Point>& source, const VoxelHashMap& targ
   const double radius = std::max(1.0, std::sqrt(radius_sq / static_cast<double>(source.size())));
   result.radius = radius;
 
-  std::vector<Correspondence> correspondences(source.size());
+  Pass pass;
   double gate = config.initial_max_distance;
+  // Coarse stage: while the pose may still be far off, every search reaches far (a wide
+  // gate visits hundreds of voxels), so a sparse, evenly spread subset of the source steers
+  // with the gate held wide until the pose stops moving. The fine stage then refines with
+  // every point and the adaptive gate, where a search visits a handful of voxels.
+  bool coarse = true;
+  int coarse_iterations = 0;
+  bool reuse = false;
+  double moved_since_search = std::numeric_limits<double>::infinity();  // m, since the last Search::All
   LinearSystem system;
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
-    // In the first iterations, while the gate is wide (the pose still far off, every
-    // search expensive), a quarter of the source points steers; all of them refine.
-    const long stride = iteration < 5 && gate > 2.0 * config.min_max_distance ? 4 : 1;
-    associate(source, target, result.pose, gate, config.metric, stride, correspondences);
-    const double spread = residualSpread(correspondences, config.metric, result.inliers, result.rms_residual);
+    const long stride = coarse ? coarseStride(source.size()) : 1;
     // The kernel scale is a third of the gate: while the pose is still uncertain every
-    // correspondence in the gate pulls, even when most residuals are already small.
-    result.kernel_scale = std::max(config.min_kernel_scale, gate / 3.0);
+    // correspondence in the gate pulls, even when most residuals are already small. In the
+    // coarse stage the gate is wide to reach far partners, and a tighter kernel keeps the
+    // mismatches it admits from steering.
+    result.kernel_scale = std::max(config.min_kernel_scale, gate / (coarse ? kCoarseKernelDivisor : 3.0));
+    Search search = Search::All;
+    if (reuse) {
+      search = Search::Reuse;
+    } else if (moved_since_search < kMissMotion * gate) {
+      search = Search::SkipMisses;
+    } else {
+      moved_since_search = 0.0;
+    }
+    associateAndBuild(source, target, result.pose, gate, config.metric, stride, search, result.kernel_scale,
+                      result.pivot, pass);
+    const double spread = residualSpread(pass.residuals, result.inliers, result.rms_residual);
     result.iterations = iteration + 1;
-    if (result.inliers < 6) break;
-    system = buildSystem(correspondences, config.metric, result.kernel_scale, result.pivot);
-    const Vector6d step = solve(system, radius, config.min_eigenvalue_ratio, result.eigenvalue_ratio);
+    if (result.inliers < 6) {
+      if (coarse) {  // too few sampled points matched: let every point try
+        coarse = false;
+        moved_since_search = std::numeric_limits<double>::infinity();
+        continue;
+      }
+      break;
+    }
+    system = pass.system;
+    // Directions the coarse stage constrains only weakly (along a corridor) are left to the
+    // fine stage, whose correspondences are right: wide-gate mismatches would push them.
+    const double min_ratio = (coarse ? kCoarseEigenvalueFactor : 1.0) * config.min_eigenvalue_ratio;
+    const Vector6d step = solve(system, radius, min_ratio, result.eigenvalue_ratio);
     result.pose = applyIncrement(step, result.pivot, result.pose);
 
-    // The adaptive threshold: the gate follows the residual spread plus how far points
-    // just moved, so it stays wide while the pose still travels and closes in once it
-    // settles (never below min_max_distance).
     const double step_translation = step.tail<3>().norm();
     const double step_rotation = step.head<3>().norm();
     const double motion = step_translation + step_rotation * radius;
+    moved_since_search += motion;
+    // The adaptive threshold: the gate follows the residual spread plus how far points
+    // just moved, so it stays wide while the pose still travels and closes in once it
+    // settles (never below min_max_distance).
     const double next_gate =
         std::max(config.min_max_distance, std::min(gate, 3.0 * spread + 2.0 * motion));
-    const bool settled = gate - next_gate < 0.01 * gate && stride == 1;
+    if (coarse) {
+      ++coarse_iterations;
+      if (motion < kCoarseSettledMotion * config.min_max_distance || coarse_iterations >= kMaxCoarseIterations) {
+        coarse = false;
+        gate = next_gate;
+      }
+      continue;
+    }
+    const bool settled = gate - next_gate < 0.01 * gate;
+    reuse = gate == next_gate && motion < kReuseMotion * config.min_kernel_scale;
     gate = next_gate;
     if (settled && step_translation < config.convergence_translation &&
         step_rotation < config.convergence_rotation) {

@@ -41,11 +41,11 @@ SequenceRegistration::SequenceRegistration(const SequenceConfig& config)
     : config_(config), map_(config.map_voxel_size, config.max_points_per_voxel) {}
 
 IcpResult SequenceRegistration::addScan(const std::vector<Point>& points, const Pose& odometry) {
-  const std::vector<Point> cropped = cropRange(points, config_.min_range, config_.max_range);
   // The map and the local maps take a finer sample than the ICP source: their normals
   // need neighbours.
-  const std::vector<Point> dense = voxelDownSample(cropped, config_.map_voxel_size / 2.0);
-  std::vector<Point> source = voxelDownSample(cropped, config_.source_voxel_size);
+  const std::vector<Point> dense =
+      voxelDownSample(points, config_.map_voxel_size / 2.0, config_.min_range, config_.max_range);
+  std::vector<Point> source = voxelDownSample(points, config_.source_voxel_size, config_.min_range, config_.max_range);
 
   IcpResult result;
   Pose pose = odometry;

@@ -10,30 +10,27 @@
 namespace mlmap::registration {
 namespace {
 
-constexpr long kKeyCentre = 32768;  // octomap's tree_max_val at depth 16
-constexpr long kKeyMax = 65535;
+// OctoMap's key range at depth 16: keys floor(c / resolution) + 32768 in [0, 65535].
+constexpr std::int32_t kKeyMin = -32768;
+constexpr std::int32_t kKeyMax = 32767;
 
-// Running sums of a neighbourhood for its PCA.
-struct Moments {
-  std::size_t count = 0;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();  // Σ (p − reference)(p − reference)ᵀ
-  Point reference = Point::Zero();                  // subtracted first, for precision far from 0
-  void add(const Point& point) {
-    const Eigen::Vector3d d = point - reference;
-    ++count;
-    sum += d;
-    outer.noalias() += d * d.transpose();
-  }
-};
+bool inKeyRange(const VoxelKey& key) {
+  return key.x >= kKeyMin && key.x <= kKeyMax && key.y >= kKeyMin && key.y <= kKeyMax && key.z >= kKeyMin &&
+         key.z <= kKeyMax;
+}
 
-// The PCA normal of a neighbourhood, or zero when it is not planar.
-Normal planeNormal(const Moments& moments, const NormalConfig& config) {
-  if (moments.count < config.min_neighbours) return Normal::Zero();
-  const double n = static_cast<double>(moments.count);
-  const Eigen::Vector3d mean = moments.sum / n;
-  const Eigen::Matrix3d covariance = moments.outer - n * mean * mean.transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+// The PCA normal of a neighbourhood from its moments (about any nearby point), or zero when it
+// is not planar.
+Normal planeNormal(std::size_t count, const Eigen::Vector3d& sum, const Eigen::Matrix3d& outer,
+                   const NormalConfig& config) {
+  if (count < config.min_neighbours) return Normal::Zero();
+  const double n = static_cast<double>(count);
+  const Eigen::Vector3d mean = sum / n;
+  const Eigen::Matrix3d covariance = (outer - n * mean * mean.transpose()) / n;
+  // The closed-form 3×3 solver: a few times faster than the iterative one, and exact enough
+  // for the well-separated smallest eigenvalue of a planar patch (the only case kept below).
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(covariance);
   const Eigen::Vector3d eigenvalues = solver.eigenvalues();  // ascending
   const double total = eigenvalues.sum();
   // Planar: thin across (low curvature) and spread in two directions (not a line or a
@@ -44,102 +41,147 @@ Normal planeNormal(const Moments& moments, const NormalConfig& config) {
   return Normal::Zero();
 }
 
+// Voxel offsets whose centres lie within `radius` voxels of the origin's centre.
+std::vector<VoxelKey> sphereStencil(double radius) {
+  const auto reach = static_cast<std::int32_t>(std::floor(radius));
+  std::vector<VoxelKey> offsets;
+  for (std::int32_t dx = -reach; dx <= reach; ++dx) {
+    for (std::int32_t dy = -reach; dy <= reach; ++dy) {
+      for (std::int32_t dz = -reach; dz <= reach; ++dz) {
+        if (static_cast<double>(dx * dx + dy * dy + dz * dz) <= radius * radius) offsets.push_back({dx, dy, dz});
+      }
+    }
+  }
+  return offsets;
+}
+
+VoxelKey operator+(const VoxelKey& a, const VoxelKey& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+
 }  // namespace
 
 VoxelHashMap::VoxelHashMap(double voxel_size, std::size_t max_points_per_voxel)
-    : key_grid_(voxel_size > 0.0 ? voxel_size : 1.0), max_points_per_voxel_(max_points_per_voxel) {
+    : voxel_size_(voxel_size), inverse_size_(1.0 / voxel_size), max_points_per_voxel_(max_points_per_voxel) {
   if (!(voxel_size > 0.0)) throw Error("voxel hash map: voxel size must be positive");
   if (max_points_per_voxel == 0) throw Error("voxel hash map: max points per voxel must be positive");
 }
 
-void VoxelHashMap::addPoints(const std::vector<Point>& points) {
-  for (const Point& point : points) {
-    octomap::OcTreeKey key;
-    if (!key_grid_.coordToKeyChecked(point.x(), point.y(), point.z(), key)) continue;
-    Voxel& voxel = voxels_[key];
-    if (voxel.points.size() >= max_points_per_voxel_) continue;
-    voxel.points.push_back(point);
-    voxel.dirty = true;
-    ++size_;
-  }
+Point VoxelHashMap::centreOf(const VoxelKey& key) const {
+  return Point(static_cast<double>(key.x) + 0.5, static_cast<double>(key.y) + 0.5, static_cast<double>(key.z) + 0.5) *
+         voxel_size_;
 }
 
-// Calls visit(voxel) for each stored voxel within `radius` of `query` (its box, not its
+void VoxelHashMap::addPoints(const std::vector<Point>& points) {
+  // Which points find room in their voxel (the first max_points_per_voxel), counted per
+  // voxel; then every voxel's points are packed again, old ones first, in one pass.
+  std::vector<std::uint32_t> counts(table_.size());
+  for (std::size_t v = 0; v < table_.size(); ++v) counts[v] = static_cast<std::uint32_t>(pointsIn(v));
+  std::vector<std::pair<std::uint32_t, std::size_t>> accepted;  // (voxel, index in `points`)
+  accepted.reserve(points.size());
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    const Point& point = points[p];
+    if (!point.allFinite()) continue;
+    const VoxelKey key = voxelKeyOf(point, inverse_size_);
+    if (!inKeyRange(key)) continue;
+    const auto [voxel, inserted] = table_.insert(key);
+    if (inserted) {
+      counts.push_back(0);
+      normals_.push_back(Normal::Zero());
+      moments_.emplace_back();
+      dirty_.push_back(0);
+    }
+    if (counts[voxel] >= max_points_per_voxel_) continue;
+    ++counts[voxel];
+    accepted.emplace_back(voxel, p);
+    const Eigen::Vector3d d = point - centreOf(key);
+    moments_[voxel].sum += d;
+    moments_[voxel].outer.noalias() += d * d.transpose();
+    dirty_[voxel] = 1;
+  }
+  if (accepted.empty()) return;
+
+  std::vector<std::uint32_t> begin(table_.size() + 1, 0);
+  for (std::size_t v = 0; v < table_.size(); ++v) begin[v + 1] = begin[v] + counts[v];
+  std::vector<Point> packed(begin.back());
+  std::vector<std::uint32_t> cursor(begin.begin(), begin.end() - 1);
+  for (std::size_t v = 0; v + 1 < begin_.size(); ++v) {
+    std::copy(points_.begin() + begin_[v], points_.begin() + begin_[v + 1], packed.begin() + cursor[v]);
+    cursor[v] += begin_[v + 1] - begin_[v];
+  }
+  for (const auto& [voxel, p] : accepted) packed[cursor[voxel]++] = points[p];
+  begin_ = std::move(begin);
+  points_ = std::move(packed);
+}
+
+// Calls visit(index) for each stored voxel within `radius` of `query` (its box, not its
 // points), in shells of growing Chebyshev distance around the query's voxel, and stops
 // once a shell lies beyond the radius. `visit` returns the radius to go on with, so a
 // nearest-neighbour search shrinks it to the best distance found so far.
 template <typename Visit>
 void VoxelHashMap::visitVoxels(const Point& query, double radius, Visit&& visit) const {
-  const double factor = 1.0 / key_grid_.getResolution();  // as OcTree's resolution_factor
-  const double resolution = key_grid_.getResolution();
-  long own[3], low[3], high[3];
-  for (int axis = 0; axis < 3; ++axis) {
-    const double c = query[axis];
-    own[axis] = static_cast<long>(std::floor(c * factor)) + kKeyCentre;
-    low[axis] = std::max(0L, static_cast<long>(std::floor((c - radius) * factor)) + kKeyCentre);
-    high[axis] = std::min(kKeyMax, static_cast<long>(std::floor((c + radius) * factor)) + kKeyCentre);
-    if (low[axis] > high[axis]) return;
-  }
-  const auto visitKey = [&](long x, long y, long z) {
-    if (x < low[0] || x > high[0] || y < low[1] || y > high[1] || z < low[2] || z > high[2]) return;
-    const long key[3] = {x, y, z};
-    double box_distance_sq = 0.0;  // from the query to the voxel's box
-    for (int axis = 0; axis < 3; ++axis) {
-      const double lo = static_cast<double>(key[axis] - kKeyCentre) * resolution;
-      const double gap = std::max({0.0, lo - query[axis], query[axis] - (lo + resolution)});
-      box_distance_sq += gap * gap;
-    }
-    if (box_distance_sq > radius * radius) return;
-    const auto found = voxels_.find(octomap::OcTreeKey(static_cast<octomap::key_type>(x),
-                                                       static_cast<octomap::key_type>(y),
-                                                       static_cast<octomap::key_type>(z)));
-    if (found != voxels_.end()) radius = visit(found->second);
+  const VoxelKey own = voxelKeyOf(query, inverse_size_);
+  const VoxelKey low = voxelKeyOf(query - Point::Constant(radius), inverse_size_);
+  const VoxelKey high = voxelKeyOf(query + Point::Constant(radius), inverse_size_);
+  // The query's offset inside its own voxel, in voxels: the box distance of a voxel
+  // `delta` voxels away along an axis is (delta − 1 + 1 − f) or (−delta − 1 + f), clamped at 0.
+  const Eigen::Vector3d fraction = query * inverse_size_ - Eigen::Vector3d(own.x, own.y, own.z);
+  const double radius_voxels_sq = radius * radius * inverse_size_ * inverse_size_;
+  const auto gap = [](std::int32_t delta, double f) {
+    if (delta > 0) return static_cast<double>(delta) - f;
+    if (delta < 0) return f - 1.0 - static_cast<double>(delta);
+    return 0.0;
   };
-  long max_shell = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    max_shell = std::max({max_shell, std::abs(own[axis] - low[axis]), std::abs(high[axis] - own[axis])});
-  }
-  for (long k = 0; k <= max_shell; ++k) {
+  double limit_sq = radius_voxels_sq;  // in voxels², shrinks with the visitor's radius
+  const auto visitKey = [&](std::int32_t dx, std::int32_t dy, std::int32_t dz) {
+    const VoxelKey key{own.x + dx, own.y + dy, own.z + dz};
+    if (key.x < low.x || key.x > high.x || key.y < low.y || key.y > high.y || key.z < low.z || key.z > high.z) return;
+    const double gx = gap(dx, fraction.x()), gy = gap(dy, fraction.y()), gz = gap(dz, fraction.z());
+    if (gx * gx + gy * gy + gz * gz > limit_sq) return;
+    const std::uint32_t index = table_.find(key);
+    if (index == VoxelTable::kMissing) return;
+    const double next_radius = visit(index);
+    limit_sq = next_radius * next_radius * inverse_size_ * inverse_size_;
+  };
+  const std::int32_t max_shell =
+      std::max({own.x - low.x, high.x - own.x, own.y - low.y, high.y - own.y, own.z - low.z, high.z - own.z});
+  for (std::int32_t k = 0; k <= max_shell; ++k) {
     // Every voxel of shell k is at least (k − 1) voxels away from the query.
-    if (static_cast<double>(k - 1) * resolution > radius) break;
-    for (long dx = -k; dx <= k; ++dx) {
-      for (long dy = -k; dy <= k; ++dy) {
+    if (static_cast<double>(k - 1) * static_cast<double>(k - 1) > limit_sq && k > 1) break;
+    for (std::int32_t dx = -k; dx <= k; ++dx) {
+      for (std::int32_t dy = -k; dy <= k; ++dy) {
         const bool on_face = std::abs(dx) == k || std::abs(dy) == k;
-        for (long dz = -k; dz <= k; dz += (on_face || k == 0) ? 1 : 2 * k) {
-          visitKey(own[0] + dx, own[1] + dy, own[2] + dz);
-        }
+        for (std::int32_t dz = -k; dz <= k; dz += (on_face || k == 0) ? 1 : 2 * k) visitKey(dx, dy, dz);
       }
     }
   }
 }
 
 std::optional<Neighbour> VoxelHashMap::nearest(const Point& query, double max_distance) const {
-  if (!(max_distance >= 0.0) || voxels_.empty()) return std::nullopt;
+  if (!(max_distance >= 0.0) || points_.empty()) return std::nullopt;
   double best_sq = max_distance * max_distance;
-  const Point* best_point = nullptr;
-  const Normal* best_normal = nullptr;
-  visitVoxels(query, max_distance, [&](const Voxel& voxel) {
-    for (const Point& point : voxel.points) {
-      const double distance_sq = (point - query).squaredNorm();
+  std::uint32_t best_point = VoxelTable::kMissing;
+  std::uint32_t best_voxel = VoxelTable::kMissing;
+  visitVoxels(query, max_distance, [&](std::uint32_t voxel) {
+    for (std::uint32_t k = begin_[voxel]; k < begin_[voxel + 1]; ++k) {
+      const double distance_sq = (points_[k] - query).squaredNorm();
       if (distance_sq <= best_sq) {
         best_sq = distance_sq;
-        best_point = &point;
-        best_normal = &voxel.normal;
+        best_point = k;
+        best_voxel = voxel;
       }
     }
     return std::sqrt(best_sq);
   });
-  if (best_point == nullptr) return std::nullopt;
-  return Neighbour{*best_point, *best_normal, std::sqrt(best_sq)};
+  if (best_point == VoxelTable::kMissing) return std::nullopt;
+  return Neighbour{points_[best_point], normals_[best_voxel], std::sqrt(best_sq)};
 }
 
 std::vector<Point> VoxelHashMap::within(const Point& query, double radius) const {
   std::vector<Point> found;
   if (!(radius >= 0.0)) return found;
   const double radius_sq = radius * radius;
-  visitVoxels(query, radius, [&](const Voxel& voxel) {
-    for (const Point& point : voxel.points) {
-      if ((point - query).squaredNorm() <= radius_sq) found.push_back(point);
+  visitVoxels(query, radius, [&](std::uint32_t voxel) {
+    for (std::uint32_t k = begin_[voxel]; k < begin_[voxel + 1]; ++k) {
+      if ((points_[k] - query).squaredNorm() <= radius_sq) found.push_back(points_[k]);
     }
     return radius;
   });
@@ -147,38 +189,52 @@ std::vector<Point> VoxelHashMap::within(const Point& query, double radius) const
 }
 
 void VoxelHashMap::estimateNormals(const NormalConfig& config) {
-  // The voxels that gained points, in a flat list so the loop can be parallel; each
-  // writes only its own normal, so the result does not depend on the thread count.
-  std::vector<Voxel*> dirty;
-  for (auto& [key, voxel] : voxels_) {
-    if (voxel.dirty) dirty.push_back(&voxel);
-  }
-  const long count = static_cast<long>(dirty.size());
-#pragma omp parallel for schedule(dynamic, 64)
-  for (long n = 0; n < count; ++n) {
-    Voxel& voxel = *dirty[static_cast<std::size_t>(n)];
-    Point centre = Point::Zero();
-    for (const Point& point : voxel.points) centre += point;
-    centre /= static_cast<double>(voxel.points.size());
-    Moments moments;
-    moments.reference = centre;
-    const double radius_sq = config.radius * config.radius;
-    visitVoxels(centre, config.radius, [&](const Voxel& neighbour) {
-      for (const Point& point : neighbour.points) {
-        if ((point - centre).squaredNorm() <= radius_sq) moments.add(point);
+  const std::vector<VoxelKey> stencil = sphereStencil(config.radius * inverse_size_);
+  // The voxels to (re)estimate: those that gained points and, when only some did, the
+  // neighbours whose stencil reaches them (their neighbourhood changed too).
+  const std::size_t voxels = table_.size();
+  std::vector<std::uint32_t> todo;
+  if (static_cast<std::size_t>(std::count(dirty_.begin(), dirty_.end(), 1)) == voxels) {
+    todo.resize(voxels);
+    for (std::size_t v = 0; v < voxels; ++v) todo[v] = static_cast<std::uint32_t>(v);
+  } else {
+    std::vector<char> marked(voxels, 0);
+    for (std::size_t v = 0; v < voxels; ++v) {
+      if (dirty_[v] == 0) continue;
+      for (const VoxelKey& offset : stencil) {  // the stencil is symmetric
+        const std::uint32_t index = table_.find(table_.key(static_cast<std::uint32_t>(v)) + offset);
+        if (index != VoxelTable::kMissing) marked[index] = 1;
       }
-      return config.radius;
-    });
-    voxel.normal = planeNormal(moments, config);
+    }
+    for (std::size_t v = 0; v < voxels; ++v) {
+      if (marked[v] != 0) todo.push_back(static_cast<std::uint32_t>(v));
+    }
   }
-  for (Voxel* voxel : dirty) voxel->dirty = false;
+  // Each voxel writes only its own normal, so the result does not depend on the thread count.
+  const long count = static_cast<long>(todo.size());
+#pragma omp parallel for schedule(dynamic, 256)
+  for (long n = 0; n < count; ++n) {
+    const std::uint32_t voxel = todo[static_cast<std::size_t>(n)];
+    std::size_t points = 0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();  // about this voxel's centre
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+    for (const VoxelKey& offset : stencil) {
+      const std::uint32_t index = table_.find(table_.key(voxel) + offset);
+      if (index == VoxelTable::kMissing) continue;
+      const Moments& moments = moments_[index];
+      // Moments about the neighbour's centre, moved to this voxel's: d' = d + shift.
+      const Eigen::Vector3d shift = Eigen::Vector3d(offset.x, offset.y, offset.z) * voxel_size_;
+      const double n_points = static_cast<double>(pointsIn(index));
+      points += pointsIn(index);
+      sum += moments.sum + n_points * shift;
+      outer += moments.outer + moments.sum * shift.transpose() + shift * moments.sum.transpose() +
+               n_points * shift * shift.transpose();
+    }
+    normals_[voxel] = planeNormal(points, sum, outer, config);
+  }
+  std::fill(dirty_.begin(), dirty_.end(), 0);
 }
 
-std::vector<Point> VoxelHashMap::points() const {
-  std::vector<Point> all;
-  all.reserve(size_);
-  for (const auto& [key, voxel] : voxels_) all.insert(all.end(), voxel.points.begin(), voxel.points.end());
-  return all;
-}
+std::vector<Point> VoxelHashMap::points() const { return points_; }
 
 }  // namespace mlmap::registration

@@ -3,6 +3,13 @@
 // from the 6×6 normal equations (Eigen, no Ceres). The adaptive threshold: the
 // correspondence gate shrinks to 3× the residuals' robust spread plus the last step's
 // motion, and the kernel scale is a third of the gate.
+// Two stages: a coarse one on an evenly spread ~1500-point subset of the source with the
+// gate held at its initial width until the pose stops moving (the wide searches are the
+// costly ones, and a wide gate is what brings a pose back from decimetres and degrees off),
+// then every point with the adaptive gate. Searches are skipped where their answer cannot
+// have changed much: points that found nothing within the gate wait until the pose has moved
+// a quarter of the gate, and once an iteration moves points by less than 2 mm the
+// correspondences are kept and only re-linearised.
 // The result says when it cannot be trusted: too few inliers, or degenerate geometry (a
 // near-zero eigenvalue of the normal equations, e.g. along a featureless corridor).
 #pragma once

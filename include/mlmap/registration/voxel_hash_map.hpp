@@ -1,16 +1,18 @@
-// Nearest neighbours through the OcTree key grid: the points of a map bucketed by
-// octomap::OcTreeKey at the map resolution (a voxel hash, like KISS-ICP's VoxelHashMap).
-// A query visits only the voxels its search sphere's bounding box overlaps, nearest
-// first, and skips voxels farther than the best point found so far.
+// Nearest neighbours through the OcTree key grid: the points of a map bucketed by their
+// octomap::OcTreeKey at the map resolution, i.e. floor(c / resolution) (a voxel hash, like
+// KISS-ICP's VoxelHashMap), in a flat VoxelTable. A query visits only the voxels its search
+// sphere's bounding box overlaps, nearest first, and skips voxels farther than the best
+// point found so far. Each voxel keeps the moments of its points, so a normal is a sum of a
+// few neighbouring voxels' moments and one 3×3 eigen-decomposition, not a radius search.
 #pragma once
 
-#include <octomap/OcTree.h>
-
+#include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
-#include <unordered_map>
 #include <vector>
 
+#include "mlmap/registration/voxel_table.hpp"
 #include "mlmap/scan.hpp"
 
 namespace mlmap::registration {
@@ -24,7 +26,7 @@ struct Neighbour {
 };
 
 struct NormalConfig {
-  double radius = 0.2;             // m, PCA neighbourhood of a voxel's centroid
+  double radius = 0.2;             // m, PCA over the voxels whose centres lie this close to the voxel's
   std::size_t min_neighbours = 6;  // fewer leaves the normal zero
   double max_curvature = 0.05;     // λ_min / (λ0 + λ1 + λ2) above this: not planar, zero normal
 };
@@ -38,8 +40,9 @@ class VoxelHashMap {
 
   // Points outside the OcTree's key range (±32768 voxels) are skipped.
   void addPoints(const std::vector<Point>& points);
-  // One normal per voxel: PCA over the points within config.radius of the voxel's
-  // centroid, for the voxels that gained points since the last call.
+  // One normal per voxel: PCA over the points of the voxels whose centres lie within
+  // config.radius of its centre, for the voxels whose neighbourhood gained points since the
+  // last call.
   void estimateNormals(const NormalConfig& config = {});
 
   // The nearest point within `max_distance` of `query`, if any.
@@ -48,24 +51,34 @@ class VoxelHashMap {
   std::vector<Point> within(const Point& query, double radius) const;
 
   std::vector<Point> points() const;
-  std::size_t size() const { return size_; }
-  bool empty() const { return size_ == 0; }
-  std::size_t voxelCount() const { return voxels_.size(); }
-  double voxelSize() const { return key_grid_.getResolution(); }
+  std::size_t size() const { return points_.size(); }
+  bool empty() const { return points_.empty(); }
+  std::size_t voxelCount() const { return table_.size(); }
+  double voxelSize() const { return voxel_size_; }
 
  private:
-  struct Voxel {
-    std::vector<Point> points;
-    Normal normal = Normal::Zero();  // shared by the voxel's points
-    bool dirty = false;              // gained points since the last estimateNormals()
+  // Moments of a voxel's points about its centre (not the origin: precision far from it).
+  struct Moments {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();    // Σ d, d = p − centre
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();  // Σ d dᵀ
   };
   template <typename Visit>
   void visitVoxels(const Point& query, double radius, Visit&& visit) const;
+  Point centreOf(const VoxelKey& key) const;
+  std::size_t pointsIn(std::size_t voxel) const { return begin_[voxel + 1] - begin_[voxel]; }
 
-  octomap::OcTree key_grid_;  // stays empty: its coordToKey defines the voxels
+  double voxel_size_;
+  double inverse_size_;
   std::size_t max_points_per_voxel_;
-  std::size_t size_ = 0;
-  std::unordered_map<octomap::OcTreeKey, Voxel, octomap::OcTreeKey::KeyHash> voxels_;
+  // Per voxel, in insertion order (the table maps a key to its index and back). A query
+  // touches only the table, begin_ and points_: the points of all voxels packed in one array,
+  // voxel by voxel, so a voxel's points are one contiguous read.
+  VoxelTable table_;
+  std::vector<std::uint32_t> begin_{0};  // voxel v holds points_[begin_[v], begin_[v + 1])
+  std::vector<Point> points_;
+  std::vector<Normal> normals_;          // shared by the voxel's points
+  std::vector<Moments> moments_;
+  std::vector<char> dirty_;              // gained points since the last estimateNormals()
 };
 
 }  // namespace mlmap::registration
