@@ -161,16 +161,16 @@ bool Detector::accept(std::size_t index) {
       continue;
     }
     if (taken.empty()) ++accepted_;
-    Patch outlined = patch;
-    outlined.outline = outlineOf(grid_, patch.blocks, accepted.plane.normal.cast<double>(),
-                                 accepted.plane.point.cast<double>());
-    Plane plane = describePatch(grid_, outlined, accepted.plane, kappa);
+    // Its outline is traced after the search (tracePendingOutlines), on the plane it was split on.
+    Plane plane = describePatch(grid_, patch, accepted.plane, kappa);
     plane.id = static_cast<std::int32_t>(patches_.planes.size() + 1);
     plane.source = accepted_;
     plane.candidates = since_acceptance_;
     for (const std::uint32_t id : patch.blocks) patches_.labels[id] = plane.id;
     taken.insert(taken.end(), patch.blocks.begin(), patch.blocks.end());
     patches_.blocks.push_back(patch.blocks);
+    patches_.outline_frames.push_back(
+        OutlineFrame{accepted.plane.normal.cast<double>(), accepted.plane.point.cast<double>(), true});
     patches_.planes.push_back(std::move(plane));
   }
   if (taken.empty()) {
@@ -269,6 +269,10 @@ PatchSet Detector::run(ErmsmStats& stats) {
   // further apart than ε allows a block.
   mergeCoplanar(grid_, patches_, config_.epsilon + 0.5 * grid_.cellSize(), radians(config_.kappa_deg));
   stats.stages.merges = secondsSince(merge_start);
+  // Classification reads the outlines: the patches' and the merged groups' traced now.
+  const auto outline_start = Clock::now();
+  tracePendingOutlines(grid_, patches_, config_.threads);
+  stats.stages.patches += secondsSince(outline_start);
   return std::move(patches_);
 }
 
@@ -321,6 +325,7 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   stage();
   classifyPlanes(patches.planes);
   mergeLevels(grid, patches, radians(config.kappa_deg));
+  tracePendingOutlines(grid, patches, config.threads);  // the merged levels'
   stats.stages.merges += stage();
   detection.planes = std::move(patches.planes);
   for (std::size_t n = 0; n < grid.cellCount(); ++n) {

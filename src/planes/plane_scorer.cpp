@@ -449,17 +449,17 @@ void PlaneScorer::collect(const Query& query, const Query* except, IdSet& ids) c
 }
 
 void PlaneScorer::take(const std::vector<std::uint32_t>& ids) {
-  std::vector<std::uint32_t> dirty;
+  // The dirty tiles as a bitmap: sorting a tile per taken block (150 000 for a floor
+  // at 2 cm) cost more than refreshing them.
+  IdSet dirty(tiles_.size());
   for (const std::uint32_t id : ids) {
     taken_[id] = 1;
     const std::uint32_t k = position_[id];
     if (k == UINT32_MAX) continue;
     order_taken_[k] = 1;
-    dirty.push_back(tile_of_[k]);
+    dirty.insert(tile_of_[k]);
   }
-  std::sort(dirty.begin(), dirty.end());
-  dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
-  refresh(dirty, 1);
+  refresh(dirty.ascending(), 1);
 }
 
 }  // namespace mlmap
