@@ -93,7 +93,38 @@ class Detector {
   std::int32_t since_acceptance_ = 0;
   ErmsmStats* stats_ = nullptr;
   std::vector<CandidatePlane> refused_;  // accepted planes that kept no patch, since blocks were last taken
+  // Per kept patch, what describing it needs: no decision of the search reads a patch's
+  // fit, so the patches are described after it, all at once on all threads.
+  struct Undescribed {
+    CandidatePlane reference;  // the accepted plane it was split from
+    double surface;            // surface units
+  };
+  std::vector<Undescribed> undescribed_;
+  void describePatches();
 };
+
+// Each patch into its own slot: the same planes at any thread count.
+void Detector::describePatches() {
+#ifdef _OPENMP
+  const int threads = config_.threads > 0 ? config_.threads : omp_get_max_threads();
+#endif
+  const double kappa = radians(config_.kappa_deg);
+  const auto count = static_cast<std::int64_t>(patches_.planes.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (count > 1)
+  for (std::int64_t n = 0; n < count; ++n) {
+    const auto k = static_cast<std::size_t>(n);
+    Patch patch;
+    patch.blocks = std::move(patches_.blocks[k]);
+    patch.surface = undescribed_[k].surface;
+    Plane described = describePatch(grid_, patch, undescribed_[k].reference, kappa);
+    Plane& plane = patches_.planes[k];
+    described.id = plane.id;
+    described.source = plane.source;
+    described.candidates = plane.candidates;
+    plane = std::move(described);
+    patches_.blocks[k] = std::move(patch.blocks);
+  }
+}
 
 // bestCandidate of Algorithm 1, lazily: a stale score is an upper bound (taking
 // blocks only lowers scores), so only the leader is ever rescored.
@@ -161,8 +192,10 @@ bool Detector::accept(std::size_t index) {
       continue;
     }
     if (taken.empty()) ++accepted_;
-    // Its outline is traced after the search (tracePendingOutlines), on the plane it was split on.
-    Plane plane = describePatch(grid_, patch, accepted.plane, kappa);
+    // Described after the search (describePatches), its outline traced after the merges
+    // (tracePendingOutlines) on the plane it was split on.
+    Plane plane;
+    undescribed_.push_back(Undescribed{accepted.plane, patch.surface});
     plane.id = static_cast<std::int32_t>(patches_.planes.size() + 1);
     plane.source = accepted_;
     plane.candidates = since_acceptance_;
@@ -263,6 +296,9 @@ PatchSet Detector::run(ErmsmStats& stats) {
     }
   }
   stats.accepted = static_cast<std::size_t>(accepted_);
+  const auto describe_start = Clock::now();
+  describePatches();
+  stats.stages.patches += secondsSince(describe_start);
   stats.stages.search = std::max(0.0, secondsSince(start) - stats.stages.patches);
   const auto merge_start = Clock::now();
   // Block points sit at cell centres: pieces of one surface lie up to half a cell
