@@ -36,6 +36,11 @@ double secondsSince(Clock::time_point start) {
 
 double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
+// Threads for the passes over the kept patches (descriptions, outlines): maps under
+// 100 000 blocks use one, as the scorer's index does. There the passes take a few
+// milliseconds, and on a shared machine a parallel region can wait as long for a core.
+int patchPassThreads(const BlockGrid& grid, int threads) { return grid.size() < 100000 ? 1 : threads; }
+
 // The range noise of the map's points: a vertical block keeps the variance of its
 // top measurement (section IV), so their median is a measurement's. 1 cm without any.
 double rangeNoise(const MLMap& map) {
@@ -106,7 +111,8 @@ class Detector {
 // Each patch into its own slot: the same planes at any thread count.
 void Detector::describePatches() {
 #ifdef _OPENMP
-  const int threads = config_.threads > 0 ? config_.threads : omp_get_max_threads();
+  const int requested = patchPassThreads(grid_, config_.threads);
+  const int threads = requested > 0 ? requested : omp_get_max_threads();
 #endif
   const double kappa = radians(config_.kappa_deg);
   const auto count = static_cast<std::int64_t>(patches_.planes.size());
@@ -307,7 +313,7 @@ PatchSet Detector::run(ErmsmStats& stats) {
   stats.stages.merges = secondsSince(merge_start);
   // Classification reads the outlines: the patches' and the merged groups' traced now.
   const auto outline_start = Clock::now();
-  tracePendingOutlines(grid_, patches_, config_.threads);
+  tracePendingOutlines(grid_, patches_, patchPassThreads(grid_, config_.threads));
   stats.stages.patches += secondsSince(outline_start);
   return std::move(patches_);
 }
@@ -361,7 +367,7 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   stage();
   classifyPlanes(patches.planes);
   mergeLevels(grid, patches, radians(config.kappa_deg));
-  tracePendingOutlines(grid, patches, config.threads);  // the merged levels'
+  tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));  // the merged levels'
   stats.stages.merges += stage();
   detection.planes = std::move(patches.planes);
   for (std::size_t n = 0; n < grid.cellCount(); ++n) {
