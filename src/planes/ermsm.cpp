@@ -36,6 +36,11 @@ double secondsSince(Clock::time_point start) {
 
 double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
+// Threads for the passes over the kept patches (descriptions, outlines): maps under
+// 100 000 blocks use one, as the scorer's index does. There the passes take a few
+// milliseconds, and on a shared machine a parallel region can wait as long for a core.
+int patchPassThreads(const BlockGrid& grid, int threads) { return grid.size() < 100000 ? 1 : threads; }
+
 // The range noise of the map's points: a vertical block keeps the variance of its
 // top measurement (section IV), so their median is a measurement's. 1 cm without any.
 double rangeNoise(const MLMap& map) {
@@ -93,7 +98,39 @@ class Detector {
   std::int32_t since_acceptance_ = 0;
   ErmsmStats* stats_ = nullptr;
   std::vector<CandidatePlane> refused_;  // accepted planes that kept no patch, since blocks were last taken
+  // Per kept patch, what describing it needs: no decision of the search reads a patch's
+  // fit, so the patches are described after it, all at once on all threads.
+  struct Undescribed {
+    CandidatePlane reference;  // the accepted plane it was split from
+    double surface;            // surface units
+  };
+  std::vector<Undescribed> undescribed_;
+  void describePatches();
 };
+
+// Each patch into its own slot: the same planes at any thread count.
+void Detector::describePatches() {
+#ifdef _OPENMP
+  const int requested = patchPassThreads(grid_, config_.threads);
+  const int threads = requested > 0 ? requested : omp_get_max_threads();
+#endif
+  const double kappa = radians(config_.kappa_deg);
+  const auto count = static_cast<std::int64_t>(patches_.planes.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (count > 1)
+  for (std::int64_t n = 0; n < count; ++n) {
+    const auto k = static_cast<std::size_t>(n);
+    Patch patch;
+    patch.blocks = std::move(patches_.blocks[k]);
+    patch.surface = undescribed_[k].surface;
+    Plane described = describePatch(grid_, patch, undescribed_[k].reference, kappa);
+    Plane& plane = patches_.planes[k];
+    described.id = plane.id;
+    described.source = plane.source;
+    described.candidates = plane.candidates;
+    plane = std::move(described);
+    patches_.blocks[k] = std::move(patch.blocks);
+  }
+}
 
 // bestCandidate of Algorithm 1, lazily: a stale score is an upper bound (taking
 // blocks only lowers scores), so only the leader is ever rescored.
@@ -161,16 +198,18 @@ bool Detector::accept(std::size_t index) {
       continue;
     }
     if (taken.empty()) ++accepted_;
-    Patch outlined = patch;
-    outlined.outline = outlineOf(grid_, patch.blocks, accepted.plane.normal.cast<double>(),
-                                 accepted.plane.point.cast<double>());
-    Plane plane = describePatch(grid_, outlined, accepted.plane, kappa);
+    // Described after the search (describePatches), its outline traced after the merges
+    // (tracePendingOutlines) on the plane it was split on.
+    Plane plane;
+    undescribed_.push_back(Undescribed{accepted.plane, patch.surface});
     plane.id = static_cast<std::int32_t>(patches_.planes.size() + 1);
     plane.source = accepted_;
     plane.candidates = since_acceptance_;
     for (const std::uint32_t id : patch.blocks) patches_.labels[id] = plane.id;
     taken.insert(taken.end(), patch.blocks.begin(), patch.blocks.end());
     patches_.blocks.push_back(patch.blocks);
+    patches_.outline_frames.push_back(
+        OutlineFrame{accepted.plane.normal.cast<double>(), accepted.plane.point.cast<double>(), true});
     patches_.planes.push_back(std::move(plane));
   }
   if (taken.empty()) {
@@ -263,12 +302,19 @@ PatchSet Detector::run(ErmsmStats& stats) {
     }
   }
   stats.accepted = static_cast<std::size_t>(accepted_);
+  const auto describe_start = Clock::now();
+  describePatches();
+  stats.stages.patches += secondsSince(describe_start);
   stats.stages.search = std::max(0.0, secondsSince(start) - stats.stages.patches);
   const auto merge_start = Clock::now();
   // Block points sit at cell centres: pieces of one surface lie up to half a cell
   // further apart than ε allows a block.
   mergeCoplanar(grid_, patches_, config_.epsilon + 0.5 * grid_.cellSize(), radians(config_.kappa_deg));
   stats.stages.merges = secondsSince(merge_start);
+  // Classification reads the outlines: the patches' and the merged groups' traced now.
+  const auto outline_start = Clock::now();
+  tracePendingOutlines(grid_, patches_, patchPassThreads(grid_, config_.threads));
+  stats.stages.patches += secondsSince(outline_start);
   return std::move(patches_);
 }
 
@@ -321,6 +367,7 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   stage();
   classifyPlanes(patches.planes);
   mergeLevels(grid, patches, radians(config.kappa_deg));
+  tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));  // the merged levels'
   stats.stages.merges += stage();
   detection.planes = std::move(patches.planes);
   for (std::size_t n = 0; n < grid.cellCount(); ++n) {

@@ -8,6 +8,10 @@
 #include "mlmap/planes/direction_vectors.hpp"
 #include "pca_sums.hpp"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace mlmap {
 namespace {
 
@@ -18,6 +22,7 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
   const std::size_t count = planes.size();
   std::vector<Plane> merged;
   std::vector<std::vector<std::uint32_t>> merged_blocks;
+  std::vector<OutlineFrame> merged_frames;
   std::vector<std::int32_t> new_id(count, 0);
   for (std::size_t k = 0; k < count; ++k) {
     if (roots[k] != k) continue;
@@ -25,9 +30,11 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
     for (std::size_t member = 0; member < count; ++member) members += roots[member] == k ? 1 : 0;
     Plane plane;
     Patch patch;
+    OutlineFrame frame;
     if (members == 1) {
       plane = planes[k];  // alone: as it was
       patch.blocks = std::move(set.blocks[k]);
+      frame = set.outline_frames[k];
     } else {
       // Each member's blocks are ascending: merged, not sorted again.
       for (std::size_t member = 0; member < count; ++member) {
@@ -39,7 +46,7 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
       const Plane& largest = planes[k];
       const CandidatePlane reference{largest.normal.cast<float>(), largest.centroid.cast<float>()};
       for (const std::uint32_t id : patch.blocks) patch.surface += grid.blocks()[id].surface;
-      patch.outline = outlineOf(grid, patch.blocks, largest.normal, largest.centroid);
+      frame = OutlineFrame{largest.normal, largest.centroid, true};
       plane = describePatch(grid, patch, reference, kappa_rad);
       plane.source = largest.source;
       plane.candidates = largest.candidates;
@@ -51,11 +58,21 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
     }
     merged.push_back(std::move(plane));
     merged_blocks.push_back(std::move(patch.blocks));
+    merged_frames.push_back(frame);
   }
   set.planes = std::move(merged);
   set.blocks = std::move(merged_blocks);
+  set.outline_frames = std::move(merged_frames);
   for (std::int32_t& label : set.labels) {
     if (label > 0) label = new_id[static_cast<std::size_t>(label - 1)];
+  }
+}
+
+// The outline lies on the plane the patch was split on: put it on the patch's own.
+void placeOutline(Plane& plane, const std::vector<Eigen::Vector3d>& corners) {
+  plane.outline.clear();
+  for (const Eigen::Vector3d& corner : corners) {
+    plane.outline.push_back(corner - plane.normal * (plane.normal.dot(corner) + plane.offset));
   }
 }
 
@@ -102,11 +119,30 @@ Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePl
     squared += distance * distance;
   }
   plane.rms = std::sqrt(squared / static_cast<double>(patch.blocks.size()));
-  // The outline lies on the plane the patch was split on: put it on the patch's own.
-  for (const Eigen::Vector3d& corner : patch.outline) {
-    plane.outline.push_back(corner - normal * (normal.dot(corner) + plane.offset));
-  }
+  placeOutline(plane, patch.outline);
   return plane;
+}
+
+void tracePendingOutlines(const BlockGrid& grid, PatchSet& set, int threads) {
+  std::vector<std::size_t> pending;
+  for (std::size_t k = 0; k < set.planes.size(); ++k) {
+    if (set.outline_frames[k].pending) pending.push_back(k);
+  }
+#ifdef _OPENMP
+  const int team = threads > 0 ? threads : omp_get_max_threads();
+#else
+  (void)threads;
+#endif
+  const auto count = static_cast<std::int64_t>(pending.size());
+  // Each plane into its own slot: the same outlines at any thread count. Largest
+  // first in the list (the search's order), so dynamic scheduling balances them.
+#pragma omp parallel for schedule(dynamic, 1) num_threads(team) if (count > 1)
+  for (std::int64_t n = 0; n < count; ++n) {
+    const std::size_t k = pending[static_cast<std::size_t>(n)];
+    OutlineFrame& frame = set.outline_frames[k];
+    placeOutline(set.planes[k], outlineOf(grid, set.blocks[k], frame.normal, frame.point));
+    frame.pending = false;
+  }
 }
 
 void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad) {

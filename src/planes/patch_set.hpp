@@ -13,9 +13,19 @@
 
 namespace mlmap {
 
+// The plane a patch's outline is traced on (the one it was split on, or a merged
+// group's largest member's), until it is: outlines are traced after the search, all
+// planes at once on all threads, since no decision of the search depends on them.
+struct OutlineFrame {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  bool pending = true;
+};
+
 struct PatchSet {
   std::vector<Plane> planes;                       // ids 1..n in order
   std::vector<std::vector<std::uint32_t>> blocks;  // block ids of each plane, ascending
+  std::vector<OutlineFrame> outline_frames;        // per plane
   std::vector<std::int32_t> labels;                // per block id: its plane's id, 0 for none
 };
 
@@ -24,13 +34,18 @@ struct PatchSet {
 // by more than κ; area, RMS, the outline moved onto the patch's own plane.
 Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad);
 
+// Traces the pending outlines (each plane on its own, on `threads` threads, 0 =
+// OpenMP's default) and moves them onto their planes as describePatch would have.
+void tracePendingOutlines(const BlockGrid& grid, PatchSet& set, int threads);
+
 // Patches of one real plane found apart (a refit that tilted a little, a wall on a
 // cell boundary) are merged when they are coplanar within ε, parallel within κ / 2
-// and touch on the grid.
+// and touch on the grid. A merged group's outline is left pending.
 void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad);
 
 // After classification: floor and ceiling patches are one level each, however far
-// apart (a floor seen between furniture, a ceiling either side of a beam).
+// apart (a floor seen between furniture, a ceiling either side of a beam). A merged
+// level's outline is left pending.
 void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad);
 
 }  // namespace mlmap

@@ -55,8 +55,8 @@ struct ErmsmStageSeconds {
   double directions = 0.0;  // direction vectors
   double index = 0.0;       // the scorer's index, the seedable blocks
   double search = 0.0;      // Algorithm 1: draws, scores, refits, acceptance tests
-  double patches = 0.0;     // accepted planes: matching and edge blocks, patch split, outlines
-  double merges = 0.0;      // coplanar merges, classification, level merges
+  double patches = 0.0;     // accepted planes: matching and edge blocks, patch split; the patches' descriptions and outlines
+  double merges = 0.0;      // coplanar merges, classification, level merges (their outlines)
   double labels = 0.0;      // labels written back into the map's blocks
 };
 
