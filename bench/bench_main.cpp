@@ -13,13 +13,10 @@
 #include <thread>
 
 #include "icp_pairs.hpp"
+#include "threads.hpp"
 #include "mlmap/map/map.hpp"
 #include "mlmap/sim/scene.hpp"
 #include "mlmap/sim/simulator.hpp"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace {
 
@@ -37,14 +34,6 @@ double peakMemoryMb() {
     if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
   }
   return 0.0;
-}
-
-int threadCount() {
-#ifdef _OPENMP
-  return omp_get_max_threads();
-#else
-  return 1;
-#endif
 }
 
 }  // namespace
@@ -82,7 +71,7 @@ int main(int argc, char** argv) {
       points += s.scan.size();
     }
     std::printf("mlmap_bench: %s, %zu poses, %zu points, %d threads, %u hardware threads\n",
-                scene.name.c_str(), scans.size(), points, threadCount(),
+                scene.name.c_str(), scans.size(), points, mlmap::bench::threadCount(),
                 std::thread::hardware_concurrency());
     std::printf("  simulate                  %8.3f s  (%.1f M points/s)\n", simulate_seconds,
                 static_cast<double>(points) / simulate_seconds / 1e6);

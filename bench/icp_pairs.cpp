@@ -7,6 +7,7 @@
 // those steps, file reading excluded, as the peers' "total"; each is the median over --runs.
 // Output: JSON on stdout; bench/icp_bench.py scores it against poses_true.txt.
 #include "icp_pairs.hpp"
+#include "threads.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -24,10 +25,6 @@
 #include "mlmap/registration/preprocessing.hpp"
 #include "mlmap/registration/sequence_registration.hpp"
 #include "mlmap/registration/voxel_hash_map.hpp"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace mlmap::bench {
 namespace {
@@ -106,14 +103,6 @@ std::string scanPath(const std::filesystem::path& scene, std::size_t index) {
   char name[32];
   std::snprintf(name, sizeof name, "scan_%03zu.xyz", index);
   return (scene / name).string();
-}
-
-int threadCount() {
-#ifdef _OPENMP
-  return omp_get_max_threads();
-#else
-  return 1;
-#endif
 }
 
 }  // namespace
