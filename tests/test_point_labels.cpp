@@ -2,6 +2,8 @@
 // the patches' planes (a block at an edge holds points of two surfaces).
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <limits>
 #include <random>
 
 #ifdef MLMAP_HAVE_OPENMP
@@ -82,11 +84,15 @@ TEST_CASE("Point labels: floor points in the wall's corner blocks leave the wall
   CHECK(floor_after > corner_floor_points * 99 / 100);
   CHECK(wall_points_on_the_wall > wall_points * 99 / 100);
   // The refitted planes are the true ones, tolerance a few noise σ.
-  const PointPlane& floor = planes[static_cast<std::size_t>(corner.floor_id)];
+  const auto byId = [&planes](std::int32_t id) {
+    return *std::find_if(planes.begin(), planes.end(), [id](const PointPlane& plane) { return plane.id == id; });
+  };
+  REQUIRE(planes.size() == corner.detection.planes.size());
+  const PointPlane floor = byId(corner.floor_id);
   CHECK(std::abs(floor.normal.z()) > std::cos(0.2 * M_PI / 180.0));
   CHECK(std::abs(floor.offset) < 0.002);
   CHECK(floor.tolerance < 0.02);
-  const PointPlane& wall = planes[static_cast<std::size_t>(corner.wall_id)];
+  const PointPlane wall = byId(corner.wall_id);
   CHECK(std::abs(wall.normal.x()) > std::cos(0.2 * M_PI / 180.0));
   CHECK(std::abs(std::abs(wall.offset) - 1.98) < 0.002);
 }
@@ -114,6 +120,9 @@ TEST_CASE("Point labels: patch ids the plane list does not know, and a hostile p
   planes.back().id = -5;
   planes.back().normal = Eigen::Vector3d::Zero();
   planes.back().offset = std::nan("");
+  planes.push_back(planes.front());  // a repeated id
+  planes.push_back(Plane{});
+  planes.back().id = std::numeric_limits<std::int32_t>::max();  // sized nothing by it
   std::vector<std::int32_t> labels = labelPoints(corner.map, scan);
   refinePointLabels(corner.map, planes, scan.points, labels);
   for (const std::int32_t label : labels) CHECK(label <= 0);

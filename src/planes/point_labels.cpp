@@ -34,9 +34,6 @@ std::vector<std::int32_t> labelPoints(const MLMap& map, const Scan& scan) {
 
 namespace {
 
-// Ids come from a map file: anything outside 1..kMaxPlaneId is treated as "none".
-constexpr std::int32_t kMaxPlaneId = 1 << 24;
-
 // Moments of a patch's points about a fixed origin (its detected centroid), so the
 // covariance keeps its precision far from the world origin.
 struct Moments {
@@ -58,10 +55,10 @@ struct Moments {
 
 // Point chunks of a fixed count, summed in chunk order: the same sums, bit for bit,
 // whatever the thread count.
-constexpr std::int64_t kChunks = 256;
+constexpr std::int64_t kChunks = 64;
 
 template <typename Accept>
-std::vector<Moments> patchMoments(std::span<const Point> points, std::span<const std::int32_t> labels,
+std::vector<Moments> patchMoments(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
                                   const std::vector<Eigen::Vector3d>& origin, Accept&& accept) {
   const std::size_t slots = origin.size();
   std::vector<std::vector<Moments>> per_chunk(kChunks);
@@ -74,10 +71,9 @@ std::vector<Moments> patchMoments(std::span<const Point> points, std::span<const
     const std::int64_t end = count * (chunk + 1) / kChunks;
     for (std::int64_t k = begin; k < end; ++k) {
       const auto index = static_cast<std::size_t>(k);
-      const std::int32_t label = labels[index];
-      if (label <= 0 || static_cast<std::size_t>(label) >= slots) continue;
-      if (!accept(label, points[index])) continue;
-      moments[static_cast<std::size_t>(label)].add(points[index] - origin[static_cast<std::size_t>(label)]);
+      const std::uint32_t slot = slot_of_point[index];
+      if (slot == 0 || !accept(slot, points[index])) continue;
+      moments[slot].add(points[index] - origin[slot]);
     }
   }
   std::vector<Moments> total(slots);
@@ -116,18 +112,27 @@ double planeDistance(const PointPlane& plane, const Point& p) {
 std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plane> planes,
                                           std::span<const Point> points, std::span<std::int32_t> labels,
                                           const PointLabelRefinement& options) {
-  std::int32_t max_id = 0;
+  // Patches by slot 1..n in id order; slot 0 is "none". Ids come from a map file: a
+  // patch id no plane has, or a plane id ≤ 0 or repeated, is none.
+  std::vector<std::int32_t> ids;
   for (const Plane& plane : planes)
-    if (plane.id > 0 && plane.id <= kMaxPlaneId) max_id = std::max(max_id, plane.id);
-  const auto slots = static_cast<std::size_t>(max_id) + 1;
+    if (plane.id > 0) ids.push_back(plane.id);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  const auto slotOf = [&ids](std::int32_t id) -> std::uint32_t {
+    const auto found = std::lower_bound(ids.begin(), ids.end(), id);
+    return found != ids.end() && *found == id ? static_cast<std::uint32_t>(found - ids.begin()) + 1 : 0;
+  };
+  const std::size_t slots = ids.size() + 1;
   std::vector<PointPlane> fitted(slots);
-  std::vector<bool> known(slots, false);
+  std::vector<bool> described(slots, false);
   std::vector<Eigen::Vector3d> origin(slots, Eigen::Vector3d::Zero());
   for (const Plane& plane : planes) {
-    if (plane.id <= 0 || plane.id > kMaxPlaneId) continue;
-    const auto slot = static_cast<std::size_t>(plane.id);
-    known[slot] = true;
+    const std::uint32_t slot = plane.id > 0 ? slotOf(plane.id) : 0;
+    if (slot == 0 || described[slot]) continue;
+    described[slot] = true;
     origin[slot] = plane.centroid.allFinite() ? plane.centroid : Eigen::Vector3d::Zero();
+    fitted[slot].id = plane.id;
     fitted[slot].normal = plane.normal.allFinite() && plane.normal.norm() > 0.0 ? plane.normal.normalized()
                                                                                : Eigen::Vector3d::UnitZ();
     fitted[slot].offset = std::isfinite(plane.offset) ? plane.offset : 0.0;
@@ -135,64 +140,63 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     const double sigma = options.noise > 0.0 ? std::min(rms, options.noise) : rms;
     fitted[slot].tolerance = std::max(options.min_tolerance, options.sigmas * sigma);
   }
-  // Labels of unknown patches are "none" from here on.
-  for (std::int32_t& label : labels)
-    if (label > 0 && (label > max_id || !known[static_cast<std::size_t>(label)])) label = 0;
+  std::vector<std::uint32_t> slot_of_point(points.size());
+  const auto count = static_cast<std::int64_t>(points.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t k = 0; k < count; ++k) {
+    const auto index = static_cast<std::size_t>(k);
+    slot_of_point[index] = labels[index] > 0 ? slotOf(labels[index]) : 0;
+  }
 
   // Two refits, each from the points near the previous plane: the detected one, then
   // the first fit. The points of a neighbouring surface that the blocks collected
   // would tilt a fit of all of them.
   for (const double first_band : {options.band, -1.0}) {
     const std::vector<PointPlane> previous = fitted;
-    const auto near_previous = [&previous, first_band](std::int32_t label, const Point& p) {
-      const PointPlane& plane = previous[static_cast<std::size_t>(label)];
+    const auto near_previous = [&previous, first_band](std::uint32_t slot, const Point& p) {
+      const PointPlane& plane = previous[slot];
       const double band = first_band < 0.0 ? plane.tolerance : first_band;
       return band == 0.0 || planeDistance(plane, p) <= band;
     };
-    const std::vector<Moments> moments = patchMoments(points, labels, origin, near_previous);
+    const std::vector<Moments> moments = patchMoments(points, slot_of_point, origin, near_previous);
     for (std::size_t slot = 1; slot < slots; ++slot) fitPlane(moments[slot], origin[slot], options, fitted[slot]);
   }
 
   const double reach = map.cellSize();
-  const auto count = static_cast<std::int64_t>(points.size());
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < count; ++k) {
     const auto index = static_cast<std::size_t>(k);
     const Point& p = points[index];
-    std::int32_t& label = labels[index];
     // Near an edge a point lies within tolerance of two planes: the more likely one
     // wins, i.e. the smaller distance in units of the plane's own spread (a floor seen
     // at a grazing angle is far thinner than a wall seen head on), the collecting
     // block's patch first among equals.
-    std::int32_t best_label = label < 0 ? -1 : 0;
+    std::int32_t best_label = labels[index] < 0 ? -1 : 0;
     double best = std::numeric_limits<double>::infinity();
-    if (label > 0) {
-      const PointPlane& own = fitted[static_cast<std::size_t>(label)];
-      const double distance = planeDistance(own, p) / own.tolerance;
-      if (distance <= 1.0) {
+    const auto consider = [&](std::uint32_t slot) {
+      const PointPlane& plane = fitted[slot];
+      const double distance = planeDistance(plane, p) / plane.tolerance;
+      if (distance <= 1.0 && distance < best) {
         best = distance;
-        best_label = label;
+        best_label = plane.id;
       }
-    }
+    };
+    if (slot_of_point[index] != 0) consider(slot_of_point[index]);
     const auto cell = map.findCellOf(p.x(), p.y());
     if (cell && p.allFinite()) {
       for (std::int32_t di = -1; di <= 1; ++di) {
         for (std::int32_t dj = -1; dj <= 1; ++dj) {
           for (const Block& block : map.blocks(CellIndex{cell->i + di, cell->j + dj})) {
-            if (block.plane <= 0 || block.plane > max_id || !known[static_cast<std::size_t>(block.plane)]) continue;
-            if (p.z() > block.height + reach || p.z() < block.bottom() - reach) continue;
-            const PointPlane& plane = fitted[static_cast<std::size_t>(block.plane)];
-            const double distance = planeDistance(plane, p) / plane.tolerance;
-            if (distance <= 1.0 && distance < best) {
-              best = distance;
-              best_label = block.plane;
-            }
+            if (block.plane <= 0 || p.z() > block.height + reach || p.z() < block.bottom() - reach) continue;
+            const std::uint32_t slot = slotOf(block.plane);
+            if (slot != 0) consider(slot);
           }
         }
       }
     }
-    label = best_label;
+    labels[index] = best_label;
   }
+  fitted.erase(fitted.begin());  // slot 0, "none"
   return fitted;
 }
 

@@ -25,6 +25,7 @@ struct PointLabelRefinement {
 };
 
 struct PointPlane {  // a patch's plane refitted to its points
+  std::int32_t id = 0;      // the patch's id
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   double offset = 0.0;      // n·x + offset = 0
   double tolerance = 0.0;   // m, points farther are not on it
@@ -38,7 +39,7 @@ struct PointPlane {  // a patch's plane refitted to its points
 // tolerance of the plane) among its block's and those of the blocks of its own and
 // the 8 neighbouring cells that reach its height, or none (0) if it lies on none.
 // `labels` are labelPoints' (any value ≤ 0 is "none"); `points` are world points.
-// Returns the refitted planes, indexed by patch id (index 0 unused). Deterministic
+// Returns the refitted planes in id order (ids ≤ 0 and repeats left out). Deterministic
 // at any thread count.
 std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plane> planes,
                                           std::span<const Point> points, std::span<std::int32_t> labels,
