@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "pca_sums.hpp"
+
 namespace mlmap {
 
 std::vector<std::int32_t> labelPoints(const MLMap& map, const Scan& scan) {
@@ -34,61 +36,41 @@ std::vector<std::int32_t> labelPoints(const MLMap& map, const Scan& scan) {
 
 namespace {
 
-// Moments of a patch's points about a fixed origin (its detected centroid), so the
-// covariance keeps its precision far from the world origin.
-struct Moments {
-  double count = 0.0;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-
-  void add(const Eigen::Vector3d& q) {
-    count += 1.0;
-    sum += q;
-    outer += q * q.transpose();
-  }
-  void add(const Moments& other) {
-    count += other.count;
-    sum += other.sum;
-    outer += other.outer;
-  }
-};
-
 // Point chunks of a fixed count, summed in chunk order: the same sums, bit for bit,
 // whatever the thread count.
 constexpr std::int64_t kChunks = 64;
 
 template <typename Accept>
-std::vector<Moments> patchMoments(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
+std::vector<PcaSums> patchMoments(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
                                   const std::vector<Eigen::Vector3d>& origin, Accept&& accept) {
   const std::size_t slots = origin.size();
-  std::vector<std::vector<Moments>> per_chunk(kChunks);
+  std::vector<std::vector<PcaSums>> per_chunk(kChunks);
   const auto count = static_cast<std::int64_t>(points.size());
 #pragma omp parallel for schedule(static)
   for (std::int64_t chunk = 0; chunk < kChunks; ++chunk) {
-    std::vector<Moments>& moments = per_chunk[static_cast<std::size_t>(chunk)];
-    moments.assign(slots, Moments{});
+    std::vector<PcaSums>& moments = per_chunk[static_cast<std::size_t>(chunk)];
+    moments.assign(slots, PcaSums{});
     const std::int64_t begin = count * chunk / kChunks;
     const std::int64_t end = count * (chunk + 1) / kChunks;
     for (std::int64_t k = begin; k < end; ++k) {
       const auto index = static_cast<std::size_t>(k);
       const std::uint32_t slot = slot_of_point[index];
       if (slot == 0 || !accept(slot, points[index])) continue;
-      moments[slot].add(points[index] - origin[slot]);
+      moments[slot].add(points[index] - origin[slot], 1.0);
     }
   }
-  std::vector<Moments> total(slots);
+  std::vector<PcaSums> total(slots);
   for (const auto& moments : per_chunk)
-    for (std::size_t slot = 0; slot < slots; ++slot) total[slot].add(moments[slot]);
+    for (std::size_t slot = 0; slot < slots; ++slot) total[slot].addShifted(moments[slot], Eigen::Vector3d::Zero());
   return total;
 }
 
 // The least-squares plane of the moments, its tolerance from the points' RMS distance.
-void fitPlane(const Moments& moments, const Eigen::Vector3d& origin, const PointLabelRefinement& options,
+void fitPlane(const PcaSums& moments, const Eigen::Vector3d& origin, const PointLabelRefinement& options,
               PointPlane& plane) {
-  if (moments.count < 3.0) return;  // keep the detected plane
-  const Eigen::Vector3d mean = moments.sum / moments.count;
-  const Eigen::Matrix3d covariance = moments.outer / moments.count - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  if (moments.weight < 3.0) return;  // keep the detected plane
+  const Eigen::Vector3d mean = moments.mean();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(moments.covariance());
   if (solver.info() != Eigen::Success) return;
   Eigen::Vector3d normal = solver.eigenvectors().col(0);
   if (!normal.allFinite()) return;
@@ -100,7 +82,7 @@ void fitPlane(const Moments& moments, const Eigen::Vector3d& origin, const Point
   // collected (a table's rim): the sensor's noise, when known, caps it.
   const double sigma = options.noise > 0.0 ? std::min(rms, options.noise) : rms;
   plane.tolerance = std::max(options.min_tolerance, options.sigmas * sigma);
-  plane.points = static_cast<std::size_t>(moments.count);
+  plane.points = static_cast<std::size_t>(moments.weight);
 }
 
 double planeDistance(const PointPlane& plane, const Point& p) {
@@ -158,7 +140,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
       const double band = first_band < 0.0 ? plane.tolerance : first_band;
       return band == 0.0 || planeDistance(plane, p) <= band;
     };
-    const std::vector<Moments> moments = patchMoments(points, slot_of_point, origin, near_previous);
+    const std::vector<PcaSums> moments = patchMoments(points, slot_of_point, origin, near_previous);
     for (std::size_t slot = 1; slot < slots; ++slot) fitPlane(moments[slot], origin[slot], options, fitted[slot]);
   }
 
