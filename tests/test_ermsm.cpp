@@ -154,3 +154,17 @@ TEST_CASE("eRMSM: an empty or tiny map gives no planes and no crash") {
   tiny.insert(Point(0.15, 0.05, 0.0), 1e-4);
   CHECK(detectPlanes(tiny).planes.empty());
 }
+
+TEST_CASE("eRMSM: a bench top two cells deep against a wall is a table at 10 cm cells") {
+  // Two rows of cells spread 0.5 cells across: level patches that narrow are real
+  // surfaces (a bench top, a stair tread), so the width rule lets them through.
+  test::PlaneSceneBuilder scene(0.1);
+  scene.floor(0.0, 0.0, 4.0, 3.0, 0.0).wallY(0.02, 0.0, 4.0, 0.0, 2.5).floor(1.01, 0.11, 2.99, 0.29, 0.45);
+  const PlaneDetection detection = detectPlanes(scene.map());
+  const Plane* top = findPlane(detection, Eigen::Vector3d::UnitZ(), -0.45);
+  REQUIRE(top != nullptr);
+  CHECK(std::abs(std::abs(top->offset) - 0.45) < 0.01);
+  CHECK(angleDeg(top->normal, Eigen::Vector3d::UnitZ()) < 1.0);
+  CHECK(top->label == PlaneClass::Table);
+  CHECK(top->area == doctest::Approx(2.0 * 0.2).epsilon(0.25));
+}

@@ -38,6 +38,7 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
                         {"min_probability", config.min_probability},
                         {"acceptance_exponent", config.acceptance_exponent},
                         {"min_patch_width_cells", config.min_patch_width_cells},
+                        {"min_level_patch_width_cells", config.min_level_patch_width_cells},
                         {"min_area", config.min_area},
                         {"min_patch_area", config.min_patch_area},
                         {"max_candidates", config.max_candidates},

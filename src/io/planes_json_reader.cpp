@@ -114,6 +114,7 @@ ErmsmConfig readParameters(const Reader& reader, const json& parameters) {
   };
   optional_number("acceptance_exponent", config.acceptance_exponent);
   optional_number("min_patch_width_cells", config.min_patch_width_cells);
+  optional_number("min_level_patch_width_cells", config.min_level_patch_width_cells);
   optional_number("min_patch_area", config.min_patch_area);
   optional_number("max_idle_candidates", config.max_idle_candidates);
   optional_number("min_patch_blocks", config.min_patch_blocks);

@@ -189,7 +189,9 @@ bool Detector::accept(std::size_t index) {
   const auto split = splitIntoPatches(grid_, matching, accepted.plane.normal.cast<double>(),
                                       accepted.plane.point.cast<double>());
   const double cell_area = grid_.cellSize() * grid_.cellSize();
-  const double min_width = config_.min_patch_width_cells * grid_.cellSize();
+  const bool level = std::abs(accepted.plane.normal.z()) >= std::cos(radians(45.0));
+  const double min_width =
+      (level ? config_.min_level_patch_width_cells : config_.min_patch_width_cells) * grid_.cellSize();
   std::vector<std::uint32_t> taken;
   for (const Patch& patch : split) {
     if (patch.surface * cell_area < config_.min_patch_area ||

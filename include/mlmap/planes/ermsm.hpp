@@ -37,6 +37,10 @@ struct ErmsmConfig {
   double min_patch_area = 0.15;   // m², smaller connected patches go back to the pool
   int min_patch_blocks = 6;       // blocks, and so do patches of fewer blocks
   double min_patch_width_cells = 0.7;  // cells, and patches whose blocks spread less across (std-dev)
+  // cells, the same for level patches: two rows of cells (a spread of 0.5) are enough. A
+  // stair tread or a bench top against a wall is two cells deep at 10 cm cells; the
+  // slivers the width rule is for are walls in room corners, where directions turn.
+  double min_level_patch_width_cells = 0.45;
   double max_direction_spread_deg = 8.0;   // deg, mean angle of a plane's blocks to its normal (curved surfaces fail)
   int max_candidates = 4000;      // Max_cp: Algorithm 1 stops after this many candidates
   int max_idle_candidates = 300;  // ... or after this many without an accepted plane
