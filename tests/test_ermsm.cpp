@@ -168,3 +168,36 @@ TEST_CASE("eRMSM: a bench top two cells deep against a wall is a table at 10 cm 
   CHECK(top->label == PlaneClass::Table);
   CHECK(top->area == doctest::Approx(2.0 * 0.2).epsilon(0.25));
 }
+
+namespace {
+
+std::vector<const Plane*> wallsFacingY(const PlaneDetection& detection) {
+  std::vector<const Plane*> walls;
+  for (const Plane& plane : detection.planes) {
+    if (plane.label == PlaneClass::Wall && angleDeg(plane.normal, Eigen::Vector3d::UnitY()) < 2.0) walls.push_back(&plane);
+  }
+  return walls;
+}
+
+}  // namespace
+
+TEST_CASE("eRMSM: a wall seen in two pieces with nothing behind the gap is one patch, an opening two") {
+  // The pieces 1.6 m apart: the middle of the wall was never seen (nothing at all
+  // there, as in a scanner's blind sector), or it is an opening with floor beyond.
+  test::PlaneSceneBuilder unseen(0.05);
+  unseen.floor(0.0, 0.03, 4.0, 3.0, 0.0).wallY(-0.02, 0.0, 1.2, 0.0, 2.5).wallY(-0.02, 2.8, 4.0, 0.0, 2.5);
+  const PlaneDetection one = detectPlanes(unseen.map());
+  const auto joined = wallsFacingY(one);
+  REQUIRE(joined.size() == 1);
+  CHECK(joined[0]->area == doctest::Approx(2 * 1.2 * 2.5).epsilon(0.1));
+  CHECK(std::abs(std::abs(joined[0]->offset) - 0.02) <= 0.03);
+
+  test::PlaneSceneBuilder opening(0.05);
+  opening.floor(0.0, 0.03, 4.0, 3.0, 0.0).wallY(-0.02, 0.0, 1.2, 0.0, 2.5).wallY(-0.02, 2.8, 4.0, 0.0, 2.5);
+  opening.floor(1.3, -2.0, 2.7, -0.08, 0.0);
+  const PlaneDetection two = detectPlanes(opening.map());
+  const auto pieces = wallsFacingY(two);
+  REQUIRE(pieces.size() == 2);
+  CHECK(pieces[0]->area == doctest::Approx(1.2 * 2.5).epsilon(0.1));
+  CHECK(pieces[1]->area == doctest::Approx(1.2 * 2.5).epsilon(0.1));
+}

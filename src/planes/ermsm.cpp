@@ -20,6 +20,7 @@
 #include "patch_rules.hpp"
 #include "patch_set.hpp"
 #include "plane_scorer.hpp"
+#include "unseen_gaps.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -186,8 +187,10 @@ bool Detector::accept(std::size_t index) {
   }
   const std::vector<std::uint32_t> matching =
       withEdges(grid_, directions_, scorer_, strict, accepted.plane, config_.epsilon, kappa);
-  const auto split = splitIntoPatches(grid_, matching, accepted.plane.normal.cast<double>(),
-                                      accepted.plane.point.cast<double>());
+  auto split = splitIntoPatches(grid_, matching, accepted.plane.normal.cast<double>(),
+                                accepted.plane.point.cast<double>());
+  joinUnseenGaps(grid_, split, accepted.plane.normal.cast<double>(), accepted.plane.point.cast<double>(),
+                 config_.epsilon);
   const double cell_area = grid_.cellSize() * grid_.cellSize();
   const bool level = std::abs(accepted.plane.normal.z()) >= std::cos(radians(45.0));
   const double min_width =

@@ -73,10 +73,18 @@ class BlockGrid {
   // `cell`, row by row and in each cell bottom to top: ids ascending.
   template <typename Visit>
   void forEachNeighbour(CellIndex cell, int radius, Visit&& visit) const {
-    const std::int64_t row_begin = std::max<std::int64_t>(cell.i - radius - min_i_, 0);
-    const std::int64_t row_end = std::min<std::int64_t>(cell.i + radius - min_i_, rows_ - 1);
-    const std::int64_t column_begin = std::max<std::int64_t>(cell.j - radius - min_j_, 0);
-    const std::int64_t column_end = std::min<std::int64_t>(cell.j + radius - min_j_, columns_ - 1);
+    forEachInCells(std::int64_t{cell.i} - radius, std::int64_t{cell.i} + radius, std::int64_t{cell.j} - radius,
+                   std::int64_t{cell.j} + radius, visit);
+  }
+
+  // The same for every block in cells i_low ≤ i ≤ i_high, j_low ≤ j ≤ j_high.
+  template <typename Visit>
+  void forEachInCells(std::int64_t i_low, std::int64_t i_high, std::int64_t j_low, std::int64_t j_high,
+                      Visit&& visit) const {
+    const std::int64_t row_begin = std::max<std::int64_t>(i_low - min_i_, 0);
+    const std::int64_t row_end = std::min<std::int64_t>(i_high - min_i_, rows_ - 1);
+    const std::int64_t column_begin = std::max<std::int64_t>(j_low - min_j_, 0);
+    const std::int64_t column_end = std::min<std::int64_t>(j_high - min_j_, columns_ - 1);
     for (std::int64_t row = row_begin; row <= row_end; ++row) {
       // The row's cells in the window hold one run of consecutive ids: from the first
       // occupied cell's first block to the last occupied cell's last.

@@ -1,0 +1,25 @@
+// Beyond the paper: a wall seen in pieces. The patch split (patches.hpp) cuts a plane
+// wherever its blocks leave a gap; a gap in a wall is either an opening, through which
+// the scanner saw what lies behind (a side corridor's floor, the next room), or a part
+// of the wall nobody saw (the scanner's blind sector, a cabinet in front). Pieces of
+// one wall with nothing seen behind the gap between them are one patch.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "mlmap/planes/block_grid.hpp"
+#include "mlmap/planes/patches.hpp"
+
+namespace mlmap {
+
+// Joins, along the wall (the plane's horizontal axis), neighbouring pieces of `patches`
+// when no block lies behind or in front of the plane by more than `epsilon` and at most
+// `reach` over the gap between them on both sides. Planes that are not walls (|n_z| ≥ 0.2)
+// are left alone: between tables at one height the floor shows below and the ceiling
+// far above. Patches stay sorted largest first; a joined patch's blocks stay ascending
+// (its outline, traced later, is its largest piece's).
+void joinUnseenGaps(const BlockGrid& grid, std::vector<Patch>& patches, const Eigen::Vector3d& normal,
+                    const Eigen::Vector3d& point, double epsilon, double reach = 1.0);
+
+}  // namespace mlmap
