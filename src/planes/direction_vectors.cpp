@@ -46,7 +46,9 @@ Neighbour neighbourAt(const PlaneBlock& block, const Eigen::Vector3f& centre) {
 // computeDirect cut to what a direction needs. The same operations in the same order
 // (Eigen's own root and kernel helpers), so the same bits; it leaves out the other two
 // eigenvectors, and for a plane's neighbourhood (the smallest eigenvalue the most
-// distinct) one of the two kernel extractions and the cross product.
+// distinct) one of the two kernel extractions and the cross product. It calls Eigen
+// internals: another Eigen version may round differently (the test against
+// computeDirect would say so), not solve differently.
 struct SmallestAxis {
   double middle_eigenvalue;
   Eigen::Vector3d vector;
@@ -71,6 +73,7 @@ SmallestAxis smallestAxis(const Eigen::Matrix3d& matrix) {
       // The largest eigenvalue is the most distinct: its kernel first, as Eigen does.
       shifted.diagonal().array() -= values(2);
       Direct::extract_kernel(shifted, other, vector);
+      // Eigen's test and update verbatim (after its swap both of its gaps are `below`).
       if (below <= 2 * Eigen::NumTraits<double>::epsilon() * below) {
         vector -= other.dot(vector) * vector;
         vector.normalize();
