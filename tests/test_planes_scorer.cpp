@@ -2,7 +2,9 @@
 // block, the eRMSM view of a cell's block stack, and fine maps end to end.
 #include <doctest/doctest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "../src/planes/plane_scorer.hpp"
@@ -50,6 +52,64 @@ test::PlaneSceneBuilder scorerScene() {
   scene.rectangle({2.5, 0.2, 0.0}, {1.2, 0.0, 0.5}, {0.0, 1.0, 0.0}, 0.02);  // a ramp, 22.6°
   scene.rectangle({3.5, 2.0, 0.0}, {0.3, 0.5, 0.0}, {0.0, 0.0, 1.0}, 0.02);  // a diagonal board
   return scene;
+}
+
+// Direction vectors as a plain scalar pass computes them: a branch per neighbour and
+// Eigen's full computeDirect (3×3) or iterative solver (2×2).
+std::vector<Eigen::Vector3f> scalarDirections(const BlockGrid& grid, int radius, float height_tolerance) {
+  std::vector<Eigen::Vector3f> directions(grid.size(), Eigen::Vector3f::Zero());
+  const double min_spread = 0.1 * grid.cellSize() * grid.cellSize();
+  const auto& blocks = grid.blocks();
+  for (std::size_t cell = 0; cell < grid.cellCount(); ++cell) {
+    for (std::uint32_t id = grid.firstBlockOfCell(cell); id < grid.firstBlockOfCell(cell + 1); ++id) {
+      const PlaneBlock& self = blocks[id];
+      const Eigen::Vector3f& centre = blocks[grid.firstBlockOfCell(cell)].point;
+      float n = 0.0F, sx = 0.0F, sy = 0.0F, sz = 0.0F, xx = 0.0F, xy = 0.0F, xz = 0.0F, yy = 0.0F, yz = 0.0F, zz = 0.0F;
+      grid.forEachNeighbour(self.cell, radius, [&](std::uint32_t other_id) {
+        const PlaneBlock& other = blocks[other_id];
+        if (other.vertical != self.vertical) return;
+        if (self.vertical ? (other.bottom > self.top || other.top < self.bottom)
+                          : std::abs(other.top - self.top) >= height_tolerance) {
+          return;
+        }
+        const float dx = other.point.x() - centre.x();
+        const float dy = other.point.y() - centre.y();
+        const float z = other.point.z() - self.point.z();
+        n += 1.0F;
+        sx += dx;
+        sy += dy;
+        sz += z;
+        xx += dx * dx;
+        xy += dx * dy;
+        xz += dx * z;
+        yy += dy * dy;
+        yz += dy * z;
+        zz += z * z;
+      });
+      if (self.vertical) {
+        if (n < 2.0F) continue;
+        const Eigen::Vector2d mean = Eigen::Vector2d(sx, sy) / n;
+        Eigen::Matrix2d covariance;
+        covariance << xx, xy, xy, yy;
+        covariance = covariance / n - mean * mean.transpose();
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(covariance);
+        if (solver.eigenvalues()(1) < min_spread) continue;
+        const Eigen::Vector2d normal = solver.eigenvectors().col(0);
+        directions[id] = orientConsistently(Eigen::Vector3f(static_cast<float>(normal.x()), static_cast<float>(normal.y()), 0.0F));
+      } else {
+        if (n < 3.0F) continue;
+        const Eigen::Vector3d mean = Eigen::Vector3d(sx, sy, sz) / n;
+        Eigen::Matrix3d covariance;
+        covariance << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+        covariance = covariance / n - mean * mean.transpose();
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+        solver.computeDirect(covariance);
+        if (solver.eigenvalues()(1) < min_spread) continue;
+        directions[id] = orientConsistently(solver.eigenvectors().col(0).cast<float>());
+      }
+    }
+  }
+  return directions;
 }
 
 }  // namespace
@@ -232,4 +292,21 @@ TEST_CASE("eRMSM: a wall seen by scan lines 12 cm apart at 5 cm cells is found, 
   CHECK(std::abs(found[0].normal.x()) > std::cos(1.0 * M_PI / 180.0));
   CHECK(std::abs(std::abs(found[0].offset) - 3.013) < 0.03);
   CHECK(found[0].area > 0.8 * 3.0 * 2.3);
+}
+
+TEST_CASE("directionVectors: bit for bit the directions of a scalar pass with Eigen's solvers, at 1 and 2 threads") {
+  test::PlaneSceneBuilder scene = scorerScene();
+  const BlockGrid grid(scene.map());
+  const std::vector<Eigen::Vector3f> expected = scalarDirections(grid, 2, 0.05F);
+  std::size_t directed = 0;
+  for (const Eigen::Vector3f& direction : expected) directed += direction.squaredNorm() > 0.0F ? 1 : 0;
+  REQUIRE(directed > grid.size() / 2);
+  for (const int threads : {1, 2}) {
+    DirectionConfig config;
+    config.height_tolerance = 0.05F;
+    config.threads = threads;
+    const std::vector<Eigen::Vector3f> directions = directionVectors(grid, config);
+    REQUIRE(directions.size() == expected.size());
+    CHECK(std::memcmp(directions.data(), expected.data(), directions.size() * sizeof(Eigen::Vector3f)) == 0);
+  }
 }

@@ -11,63 +11,128 @@
 namespace mlmap {
 namespace {
 
-// A neighbour as the blocks of one cell see it: offsets from the cell's centre.
-struct Neighbour {
-  float dx;
-  float dy;
-  float z;       // its point's height
+// The moment sums run over a cell's neighbours once per block of the cell, and which
+// neighbours count depends on the block (its height): a branch per neighbour mispredicts
+// on every table edge. Instead each neighbour's terms sit in four-float lanes (GCC/Clang
+// vector extensions, SSE2 or NEON without -march), masked to zero when it does not count,
+// and added lane by lane. Each sum still adds the same terms in the same order as a
+// scalar loop (a masked term adds +0.0F), so the sums are bit-identical to it.
+using Lanes = float __attribute__((vector_size(16)));
+using LaneMask = std::int32_t __attribute__((vector_size(16)));
+
+Lanes keepIf(bool keep, Lanes terms) {
+  const LaneMask mask = LaneMask{} - static_cast<std::int32_t>(keep);
+  return reinterpret_cast<Lanes>(reinterpret_cast<LaneMask>(terms) & mask);
+}
+
+// A neighbour as the blocks of one cell see it: offsets from the cell's centre, with the
+// terms of its moments that do not depend on the block.
+struct alignas(16) Neighbour {
+  Lanes plane;   // 1, dx, dy, dx²
+  Lanes cross;   // dx·dy, dy², 0, 0
+  Lanes offset;  // 1, dx, dy, z (its point's height); horizontal neighbours only
   float top;
   float bottom;
 };
+
+Neighbour neighbourAt(const PlaneBlock& block, const Eigen::Vector3f& centre) {
+  const float dx = block.point.x() - centre.x();
+  const float dy = block.point.y() - centre.y();
+  return {Lanes{1.0F, dx, dy, dx * dx}, Lanes{dx * dy, dy * dy, 0.0F, 0.0F}, Lanes{1.0F, dx, dy, block.point.z()},
+          block.top, block.bottom};
+}
+
+// The smallest eigenvector of a symmetric 3×3 and the middle eigenvalue: Eigen 3.4's
+// computeDirect cut to what a direction needs. The same operations in the same order
+// (Eigen's own root and kernel helpers), so the same bits; it leaves out the other two
+// eigenvectors, and for a plane's neighbourhood (the smallest eigenvalue the most
+// distinct) one of the two kernel extractions and the cross product. It calls Eigen
+// internals: another Eigen version may round differently (the test against
+// computeDirect would say so), not solve differently.
+struct SmallestAxis {
+  double middle_eigenvalue;
+  Eigen::Vector3d vector;
+};
+
+SmallestAxis smallestAxis(const Eigen::Matrix3d& matrix) {
+  using Direct = Eigen::internal::direct_selfadjoint_eigenvalues<Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>, 3, false>;
+  const double shift = matrix.trace() / 3.0;
+  Eigen::Matrix3d scaled = matrix.selfadjointView<Eigen::Lower>();
+  scaled.diagonal().array() -= shift;
+  const double scale = scaled.cwiseAbs().maxCoeff();
+  if (scale > 0) scaled /= scale;
+  Eigen::Vector3d values;
+  Direct::computeRoots(scaled, values);
+  Eigen::Vector3d vector = Eigen::Vector3d::UnitX();  // all three eigenvalues the same: any axis
+  if (values(2) - values(0) > Eigen::NumTraits<double>::epsilon()) {
+    const double above = values(2) - values(1);
+    const double below = values(1) - values(0);
+    Eigen::Matrix3d shifted = scaled;
+    Eigen::Vector3d other;
+    if (above > below) {
+      // The largest eigenvalue is the most distinct: its kernel first, as Eigen does.
+      shifted.diagonal().array() -= values(2);
+      Direct::extract_kernel(shifted, other, vector);
+      // Eigen's test and update verbatim (after its swap both of its gaps are `below`).
+      if (below <= 2 * Eigen::NumTraits<double>::epsilon() * below) {
+        vector -= other.dot(vector) * vector;
+        vector.normalize();
+      } else {
+        shifted = scaled;
+        shifted.diagonal().array() -= values(0);
+        Eigen::Vector3d unused;
+        Direct::extract_kernel(shifted, vector, unused);
+      }
+    } else {
+      shifted.diagonal().array() -= values(0);
+      Direct::extract_kernel(shifted, vector, other);
+    }
+  }
+  values *= scale;
+  values.array() += shift;
+  return {values(1), vector};
+}
 
 // Blocks of one cell share their neighbourhood: it is gathered once per cell, each
 // class in its own list, and the sums are kept in float relative to the block (offsets
 // of a few cells, heights of a few centimetres), then solved in double.
 Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const std::vector<Neighbour>& horizontal,
                                     float height_tolerance, double min_spread) {
-  float n = 0.0F, sx = 0.0F, sy = 0.0F, sz = 0.0F;
-  float xx = 0.0F, xy = 0.0F, xz = 0.0F, yy = 0.0F, yz = 0.0F, zz = 0.0F;
+  Lanes plane{}, cross{}, height{};  // n, Σx, Σy, Σx² | Σxy, Σy² | Σz, Σxz, Σyz, Σz²
+  const float self_z = self.point.z();
   for (const Neighbour& other : horizontal) {
-    if (std::abs(other.top - self.top) >= height_tolerance) continue;
-    const float z = other.z - self.point.z();
-    n += 1.0F;
-    sx += other.dx;
-    sy += other.dy;
-    sz += z;
-    xx += other.dx * other.dx;
-    xy += other.dx * other.dy;
-    xz += other.dx * z;
-    yy += other.dy * other.dy;
-    yz += other.dy * z;
-    zz += z * z;
+    const bool keep = std::abs(other.top - self.top) < height_tolerance;
+    const float z = other.offset[3] - self_z;
+    Lanes terms = other.offset;
+    terms[3] = z;
+    plane += keepIf(keep, other.plane);
+    cross += keepIf(keep, other.cross);
+    height += keepIf(keep, terms * z);  // z, dx·z, dy·z, z²
   }
+  const float n = plane[0];
   if (n < 3.0F) return Eigen::Vector3f::Zero();
-  const Eigen::Vector3d mean = Eigen::Vector3d(sx, sy, sz) / n;
+  const Eigen::Vector3d mean = Eigen::Vector3d(plane[1], plane[2], height[0]) / n;
   Eigen::Matrix3d covariance;
-  covariance << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+  covariance << plane[3], cross[0], height[1], cross[0], cross[1], height[2], height[1], height[2], height[3];
   covariance = covariance / n - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  solver.computeDirect(covariance);
+  const SmallestAxis axis = smallestAxis(covariance);
   // The neighbourhood must spread in two directions, or its normal is arbitrary.
-  if (solver.eigenvalues()(1) < min_spread) return Eigen::Vector3f::Zero();
-  return orientConsistently(solver.eigenvectors().col(0).cast<float>());
+  if (axis.middle_eigenvalue < min_spread) return Eigen::Vector3f::Zero();
+  return orientConsistently(axis.vector.cast<float>());
 }
 
 Eigen::Vector3f verticalDirection(const PlaneBlock& self, const std::vector<Neighbour>& vertical, double min_spread) {
-  float n = 0.0F, sx = 0.0F, sy = 0.0F, xx = 0.0F, xy = 0.0F, yy = 0.0F;
+  Lanes plane{}, cross{};  // n, Σx, Σy, Σx² | Σxy, Σy²
   for (const Neighbour& other : vertical) {
-    if (other.bottom > self.top || other.top < self.bottom) continue;
-    n += 1.0F;
-    sx += other.dx;
-    sy += other.dy;
-    xx += other.dx * other.dx;
-    xy += other.dx * other.dy;
-    yy += other.dy * other.dy;
+    const bool keep = !(other.bottom > self.top || other.top < self.bottom);
+    plane += keepIf(keep, other.plane);
+    cross += keepIf(keep, other.cross);
   }
+  const float n = plane[0];
   if (n < 2.0F) return Eigen::Vector3f::Zero();
-  const Eigen::Vector2d mean = Eigen::Vector2d(sx, sy) / n;
+  const Eigen::Vector2d mean = Eigen::Vector2d(plane[1], plane[2]) / n;
   Eigen::Matrix2d covariance;
-  covariance << xx, xy, xy, yy;
+  covariance << plane[3], cross[0], cross[0], cross[1];
   covariance = covariance / n - mean * mean.transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(covariance);
   if (solver.eigenvalues()(1) < min_spread) return Eigen::Vector3f::Zero();
@@ -115,8 +180,7 @@ std::vector<Eigen::Vector3f> directionVectors(const BlockGrid& grid, const Direc
       vertical.clear();
       grid.forEachNeighbour(blocks[begin].cell, config.radius, [&](std::uint32_t other) {
         const PlaneBlock& block = blocks[other];
-        (block.vertical ? vertical : horizontal)
-            .push_back({block.point.x() - centre.x(), block.point.y() - centre.y(), block.point.z(), block.top, block.bottom});
+        (block.vertical ? vertical : horizontal).push_back(neighbourAt(block, centre));
       });
       for (std::uint32_t id = begin; id < end; ++id) {
         directions[id] = blocks[id].vertical ? verticalDirection(blocks[id], vertical, min_spread)

@@ -120,11 +120,13 @@ struct PlaneRaster {
   std::int64_t columns = 0;
   std::int64_t rows = 0;
   int margin = 0;
-  std::vector<std::int32_t> slots;     // per raster cell: its number among the occupied ones, −1 empty
+  // Per raster cell, column by column (the order the cells are listed and visited in, so
+  // passes over them stream): its number among the occupied ones, −1 empty.
+  std::vector<std::int32_t> slots;
   std::vector<Eigen::Vector2i> cells;  // occupied cells, column by column
 
   std::int32_t& at(std::int64_t u, std::int64_t v) {
-    return slots[static_cast<std::size_t>((v - min_v + margin) * columns + (u - min_u + margin))];
+    return slots[static_cast<std::size_t>((u - min_u + margin) * rows + (v - min_v + margin))];
   }
 
   PlaneRaster(const std::vector<Segment>& runs, int margin_cells) : margin(margin_cells) {
@@ -154,14 +156,19 @@ struct PlaneRaster {
 // the most area, corners only.
 template <typename Inside>
 std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside) {
-  // Vertices of the raster with a margin of one: each has at most two outgoing edges.
-  const std::int64_t vertex_columns = raster.columns + 1;
+  // Vertices of the raster with a margin of one, column by column like the cells: each
+  // has at most two outgoing edges.
+  const std::int64_t vertex_rows = raster.rows + 1;
   auto vertexOf = [&](std::int64_t u, std::int64_t v) {
-    return static_cast<std::size_t>((v - raster.min_v + raster.margin) * vertex_columns + (u - raster.min_u + raster.margin));
+    return static_cast<std::size_t>((u - raster.min_u + raster.margin) * vertex_rows + (v - raster.min_v + raster.margin));
   };
-  std::vector<std::array<std::int32_t, 2>> out(static_cast<std::size_t>(vertex_columns * (raster.rows + 1)), {-1, -1});
+  std::vector<std::array<std::int32_t, 2>> out(static_cast<std::size_t>((raster.columns + 1) * vertex_rows), {-1, -1});
   std::vector<Eigen::Vector2i> edge_from;
   std::vector<Eigen::Vector2i> edge_to;
+  // A cell has at most four sides: reserved (not touched, so not paid for) against copies
+  // as a ceiling's hundreds of thousands of sides come in.
+  edge_from.reserve(4 * raster.cells.size());
+  edge_to.reserve(4 * raster.cells.size());
   auto occupied = [&](std::int64_t u, std::int64_t v) {
     if (u < raster.min_u - raster.margin || v < raster.min_v - raster.margin ||
         u >= raster.min_u - raster.margin + raster.columns || v >= raster.min_v - raster.margin + raster.rows) {
@@ -192,9 +199,11 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
   auto lowest = [&](const std::vector<Eigen::Vector2i>& loop) { return *std::min_element(loop.begin(), loop.end(), before); };
   std::vector<Eigen::Vector2i> best;
   long best_area = 0;
+  // One buffer for all loops: a ceiling's outline has tens of thousands of holes, each a loop.
+  std::vector<Eigen::Vector2i> loop;
   for (std::size_t start = 0; start < edge_from.size(); ++start) {
     if (used[start] != 0) continue;
-    std::vector<Eigen::Vector2i> loop;
+    loop.clear();
     std::int32_t edge = static_cast<std::int32_t>(start);
     while (edge >= 0 && used[static_cast<std::size_t>(edge)] == 0) {
       const auto current = static_cast<std::size_t>(edge);
@@ -223,7 +232,7 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
     // Of loops of equal area, the one with the lowest corner: not the one found first.
     if (twice_area > best_area || (twice_area == best_area && twice_area > 0 && before(lowest(loop), lowest(best)))) {
       best_area = twice_area;
-      best = std::move(loop);
+      best = loop;
     }
   }
   std::vector<Eigen::Vector2i> corners;
