@@ -189,9 +189,9 @@ bool Detector::accept(std::size_t index) {
       withEdges(grid_, directions_, scorer_, strict, accepted.plane, config_.epsilon, kappa);
   auto split = splitIntoPatches(grid_, matching, accepted.plane.normal.cast<double>(),
                                 accepted.plane.point.cast<double>());
-  joinUnseenGaps(grid_, split, accepted.plane.normal.cast<double>(), accepted.plane.point.cast<double>(),
-                 config_.epsilon);
   const double cell_area = grid_.cellSize() * grid_.cellSize();
+  joinUnseenGaps(grid_, split, accepted.plane.normal.cast<double>(), accepted.plane.point.cast<double>(),
+                 config_.epsilon, std::max<std::size_t>(config_.min_patch_blocks, 1), config_.min_patch_area / cell_area);
   const bool level = std::abs(accepted.plane.normal.z()) >= std::cos(radians(45.0));
   const double min_width =
       (level ? config_.min_level_patch_width_cells : config_.min_patch_width_cells) * grid_.cellSize();

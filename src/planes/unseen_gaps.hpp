@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <vector>
 
 #include "mlmap/planes/block_grid.hpp"
@@ -14,12 +15,15 @@
 namespace mlmap {
 
 // Joins, along the wall (the plane's horizontal axis), neighbouring pieces of `patches`
-// when no block lies behind or in front of the plane by more than `epsilon` and at most
-// `reach` over the gap between them on both sides. Planes that are not walls (|n_z| ≥ 0.2)
-// are left alone: between tables at one height the floor shows below and the ceiling
-// far above. Patches stay sorted largest first; a joined patch's blocks stay ascending
-// (its outline, traced later, is its largest piece's).
+// unless blocks lie on both sides of the plane over the gap between them, further than
+// `epsilon` from it and closer than `reach` (a doorway shows the floor beyond it).
+// Only pieces of at least `min_blocks` blocks and `min_surface` surface units, patches
+// on their own, take part: fragments stay as they are. Planes that are not walls
+// (|n_z| ≥ 0.2) are left alone: between tables at one height the floor shows below and
+// the ceiling may be far above. Patches stay sorted largest first; a joined patch's
+// blocks stay ascending (its outline, traced later, is its largest piece's).
 void joinUnseenGaps(const BlockGrid& grid, std::vector<Patch>& patches, const Eigen::Vector3d& normal,
-                    const Eigen::Vector3d& point, double epsilon, double reach = 1.0);
+                    const Eigen::Vector3d& point, double epsilon, std::size_t min_blocks, double min_surface,
+                    double reach = 0.3);
 
 }  // namespace mlmap
