@@ -42,57 +42,6 @@ Neighbour neighbourAt(const PlaneBlock& block, const Eigen::Vector3f& centre) {
           block.top, block.bottom};
 }
 
-// The smallest eigenvector of a symmetric 3×3 and the middle eigenvalue: Eigen 3.4's
-// computeDirect cut to what a direction needs. The same operations in the same order
-// (Eigen's own root and kernel helpers), so the same bits; it leaves out the other two
-// eigenvectors, and for a plane's neighbourhood (the smallest eigenvalue the most
-// distinct) one of the two kernel extractions and the cross product. It calls Eigen
-// internals: another Eigen version may round differently (the test against
-// computeDirect would say so), not solve differently.
-struct SmallestAxis {
-  double middle_eigenvalue;
-  Eigen::Vector3d vector;
-};
-
-SmallestAxis smallestAxis(const Eigen::Matrix3d& matrix) {
-  using Direct = Eigen::internal::direct_selfadjoint_eigenvalues<Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>, 3, false>;
-  const double shift = matrix.trace() / 3.0;
-  Eigen::Matrix3d scaled = matrix.selfadjointView<Eigen::Lower>();
-  scaled.diagonal().array() -= shift;
-  const double scale = scaled.cwiseAbs().maxCoeff();
-  if (scale > 0) scaled /= scale;
-  Eigen::Vector3d values;
-  Direct::computeRoots(scaled, values);
-  Eigen::Vector3d vector = Eigen::Vector3d::UnitX();  // all three eigenvalues the same: any axis
-  if (values(2) - values(0) > Eigen::NumTraits<double>::epsilon()) {
-    const double above = values(2) - values(1);
-    const double below = values(1) - values(0);
-    Eigen::Matrix3d shifted = scaled;
-    Eigen::Vector3d other;
-    if (above > below) {
-      // The largest eigenvalue is the most distinct: its kernel first, as Eigen does.
-      shifted.diagonal().array() -= values(2);
-      Direct::extract_kernel(shifted, other, vector);
-      // Eigen's test and update verbatim (after its swap both of its gaps are `below`).
-      if (below <= 2 * Eigen::NumTraits<double>::epsilon() * below) {
-        vector -= other.dot(vector) * vector;
-        vector.normalize();
-      } else {
-        shifted = scaled;
-        shifted.diagonal().array() -= values(0);
-        Eigen::Vector3d unused;
-        Direct::extract_kernel(shifted, vector, unused);
-      }
-    } else {
-      shifted.diagonal().array() -= values(0);
-      Direct::extract_kernel(shifted, vector, other);
-    }
-  }
-  values *= scale;
-  values.array() += shift;
-  return {values(1), vector};
-}
-
 // Blocks of one cell share their neighbourhood: it is gathered once per cell, each
 // class in its own list, and the sums are kept in float relative to the block (offsets
 // of a few cells, heights of a few centimetres), then solved in double.
@@ -115,10 +64,11 @@ Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const std::vector<Ne
   Eigen::Matrix3d covariance;
   covariance << plane[3], cross[0], height[1], cross[0], cross[1], height[2], height[1], height[2], height[3];
   covariance = covariance / n - mean * mean.transpose();
-  const SmallestAxis axis = smallestAxis(covariance);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(covariance);
   // The neighbourhood must spread in two directions, or its normal is arbitrary.
-  if (axis.middle_eigenvalue < min_spread) return Eigen::Vector3f::Zero();
-  return orientConsistently(axis.vector.cast<float>());
+  if (solver.eigenvalues()(1) < min_spread) return Eigen::Vector3f::Zero();
+  return orientConsistently(solver.eigenvectors().col(0).cast<float>());
 }
 
 Eigen::Vector3f verticalDirection(const PlaneBlock& self, const std::vector<Neighbour>& vertical, double min_spread) {
