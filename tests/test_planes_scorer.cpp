@@ -310,3 +310,27 @@ TEST_CASE("directionVectors: bit for bit the directions of a scalar pass with Ei
     CHECK(std::memcmp(directions.data(), expected.data(), directions.size() * sizeof(Eigen::Vector3f)) == 0);
   }
 }
+
+TEST_CASE("BlockGrid: forEachInCells visits exactly the blocks of the box's cells, in ascending ids, boxes beyond the map too") {
+  test::PlaneSceneBuilder scene = scorerScene();
+  const BlockGrid grid(scene.map());
+  REQUIRE(grid.size() > 1000);
+  struct Box {
+    std::int64_t i_low, i_high, j_low, j_high;
+  };
+  // Inside, straddling the map's edge, wholly outside, empty (low > high), one cell, huge.
+  const std::vector<Box> boxes{{10, 30, 5, 40}, {-20, 3, 70, 200}, {500, 600, 500, 600}, {20, 10, 5, 40},
+                               {12, 12, 12, 12}, {-(std::int64_t{1} << 40), std::int64_t{1} << 40, -5, 5}};
+  for (const Box& box : boxes) {
+    CAPTURE(box.i_low);
+    CAPTURE(box.j_low);
+    std::vector<std::uint32_t> expected;
+    for (std::uint32_t id = 0; id < grid.size(); ++id) {
+      const CellIndex cell = grid.blocks()[id].cell;
+      if (cell.i >= box.i_low && cell.i <= box.i_high && cell.j >= box.j_low && cell.j <= box.j_high) expected.push_back(id);
+    }
+    std::vector<std::uint32_t> visited;
+    grid.forEachInCells(box.i_low, box.i_high, box.j_low, box.j_high, [&](std::uint32_t id) { visited.push_back(id); });
+    CHECK(visited == expected);
+  }
+}
