@@ -52,21 +52,27 @@ struct RoomMaps {
       REQUIRE_MESSAGE(result.exit_code == 0, result.output);
     }
   }
+
+  // `mlmap planes -o`: the whole map with its blocks labelled.
+  fs::path labelled() const {
+    const fs::path output = dir / "labelled.mlmap";
+    const auto result = runCli("--quiet planes " + map.string() + " -o " + output.string());
+    REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+    return output;
+  }
 };
 
 }  // namespace
 
 TEST_CASE("CLI: planes -o keeps the planes in the map, and export writes every format") {
   RoomMaps rooms;
-  const fs::path labelled = rooms.dir / "labelled.mlmap";
-  auto result = runCli("--quiet planes " + rooms.map.string() + " -o " + labelled.string());
-  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  const fs::path labelled = rooms.labelled();
   REQUIRE(mlmap::io::readMap(labelled).planes().has_value());
 
   mlmap::test::writeText(rooms.dir / "page.html", "<!doctype html><title>dashboard</title>");
   const fs::path out = rooms.dir / "out";
   fs::create_directories(out);
-  result = runCli("--quiet export " + labelled.string() + " --octovis " + (out / "m.ot").string() + " --bt " +
+  auto result = runCli("--quiet export " + labelled.string() + " --octovis " + (out / "m.ot").string() + " --bt " +
                   (out / "m.bt").string() + " --ply " + (out / "m.ply").string() + " --json " +
                   (out / "m.json").string() + " --dashboard " + (out / "web").string() + " --dashboard-page " +
                   (rooms.dir / "page.html").string());
@@ -147,9 +153,7 @@ double labelPurity(const std::vector<std::int32_t>& predicted, const std::vector
 
 TEST_CASE("CLI: label writes every scan point in order with its patch, refined on the patches' planes") {
   RoomMaps rooms;
-  const fs::path labelled = rooms.dir / "labelled.mlmap";
-  auto result = runCli("--quiet planes " + rooms.map.string() + " -o " + labelled.string());
-  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  const fs::path labelled = rooms.labelled();
   std::string scans;
   std::vector<std::int32_t> truth;
   std::vector<mlmap::Scan> inputs;
@@ -162,7 +166,7 @@ TEST_CASE("CLI: label writes every scan point in order with its patch, refined o
   const std::string poses = (rooms.dir / "sim" / "poses_true.txt").string();
   const fs::path refined = rooms.dir / "refined.xyz";
   const fs::path by_block = rooms.dir / "blocks.xyz";
-  result = runCli("--quiet label " + labelled.string() + " --poses " + poses + " -o " + refined.string() + scans);
+  auto result = runCli("--quiet label " + labelled.string() + " --poses " + poses + " -o " + refined.string() + scans);
   REQUIRE_MESSAGE(result.exit_code == 0, result.output);
   result = runCli("--quiet label --block-labels " + labelled.string() + " --poses " + poses + " -o " +
                   by_block.string() + scans);
