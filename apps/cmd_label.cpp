@@ -27,15 +27,20 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
   std::vector<io::StampedPose> poses;
   if (!arguments.poses.empty()) poses = io::readTumPoses(arguments.poses);
   Scan labelled;  // all points, world frame
+  std::vector<Point> scanner_positions;       // per scan, world frame
+  std::vector<std::uint32_t> scan_of_point;  // per point
   std::size_t with_plane = 0;
   Progress progress("label", arguments.scans.size(), !quiet);
   forEachPosedScan(
       arguments.scans, poses, arguments.poses,
       [&](Scan& scan, std::size_t, std::size_t) {
         const std::vector<std::int32_t> labels = labelPoints(map.blocks(), scan);
+        const auto scan_index = static_cast<std::uint32_t>(scanner_positions.size());
+        scanner_positions.push_back(scan.pose.translation());
         for (std::size_t k = 0; k < scan.size(); ++k) {
           labelled.points.push_back(scan.worldPoint(k));
           labelled.labels.push_back(labels[k]);
+          scan_of_point.push_back(scan_index);
         }
       },
       [&](std::size_t file) { progress.update(file + 1); });
@@ -43,7 +48,8 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
   if (!arguments.block_labels && map.planes())
     refinePointLabels(map.blocks(), map.planes()->planes, labelled.points, labelled.labels,
                       PointLabelRefinement{.noise = map.planes()->config.noise,
-                                           .band = map.planes()->config.epsilon + 0.5 * map.blocks().cellSize()});
+                                           .band = map.planes()->config.epsilon + 0.5 * map.blocks().cellSize()},
+                      BeamOrigins{scanner_positions, scan_of_point});
   for (std::int32_t& label : labelled.labels) {
     // Blocks without a plane and points no block collects are both "none" here.
     if (label <= 0) label = -1;

@@ -4,14 +4,19 @@
 
 #include <algorithm>
 #include <limits>
+#include <map>
 #include <random>
+#include <string>
 
 #ifdef MLMAP_HAVE_OPENMP
 #include <omp.h>
 #endif
 
+#include "mlmap/error.hpp"
 #include "mlmap/planes/ermsm.hpp"
 #include "mlmap/planes/point_labels.hpp"
+#include "mlmap/sim/simulator.hpp"
+#include "room_scenes.hpp"
 
 using namespace mlmap;
 
@@ -144,3 +149,72 @@ TEST_CASE("Point labels: the refinement gives the same labels at 1 and 2 threads
   CHECK(runs[0] == runs[1]);
 }
 #endif
+
+TEST_CASE("Point labels: with the beams' origins, fewer points at edges take the other surface's patch") {
+  // Four scans of a room with a table and two boxes, 1 cm range noise along each beam.
+  // A point near an edge lies within noise of two planes; the likelier one is the plane
+  // its beam meets nearer the measured range, and that depends on the point's own beam:
+  // the same wall is seen head on from one pose and grazing from another.
+  std::vector<Point> points;
+  std::vector<std::int32_t> truth;
+  std::vector<Point> scanners;
+  std::vector<std::uint32_t> scanner_of_point;
+  MLMap map(0.05);
+  // Scanned twice as finely as the shared scene, for enough points at every edge.
+  std::string scene_json = test::kRoomsJson;
+  scene_json.replace(scene_json.find("\"angular_step_deg\": 1.0"), 23, "\"angular_step_deg\": 0.5");
+  scene_json.replace(scene_json.find("\"tilt_step_deg\": 2.0"), 20, "\"tilt_step_deg\": 1.0");
+  for (const sim::SimulatedScan& simulated : sim::simulate(sim::parseScene(scene_json, "rooms.json"))) {
+    const Scan& scan = simulated.scan;
+    for (std::size_t k = 0; k < scan.size(); ++k) {
+      points.push_back(scan.worldPoint(k));
+      truth.push_back(scan.labels[k]);
+      scanner_of_point.push_back(static_cast<std::uint32_t>(scanners.size()));
+      map.insert(points.back(), scan.variance(k));
+    }
+    scanners.push_back(scan.pose.translation());
+  }
+  const PlaneDetection detection = detectPlanes(map);
+  const PointLabelRefinement options{.noise = detection.config.noise,
+                                     .band = detection.config.epsilon + 0.5 * map.cellSize()};
+  Scan all;
+  all.points = points;
+  // Points on a true surface whose patch is mostly another surface's.
+  const auto misplaced = [&](const std::vector<std::int32_t>& labels) {
+    std::map<std::int32_t, std::map<std::int32_t, int>> votes;
+    for (std::size_t k = 0; k < points.size(); ++k)
+      if (labels[k] > 0 && truth[k] >= 0) ++votes[labels[k]][truth[k]];
+    int wrong = 0;
+    for (const auto& [patch, by_truth] : votes) {
+      const auto majority = std::max_element(by_truth.begin(), by_truth.end(),
+                                             [](const auto& a, const auto& b) { return a.second < b.second; });
+      for (const auto& [surface, count] : by_truth) wrong += surface == majority->first ? 0 : count;
+    }
+    return wrong;
+  };
+  std::vector<std::int32_t> by_spread = labelPoints(map, all);
+  refinePointLabels(map, detection.planes, points, by_spread, options);
+  std::vector<std::int32_t> by_beam = labelPoints(map, all);
+  refinePointLabels(map, detection.planes, points, by_beam, options, BeamOrigins{scanners, scanner_of_point});
+  const int wrong_by_spread = misplaced(by_spread);
+  const int wrong_by_beam = misplaced(by_beam);
+  MESSAGE(points.size() << " points; on another surface's patch: " << wrong_by_spread << " ranked by spread, "
+                        << wrong_by_beam << " by beam");
+  REQUIRE(wrong_by_spread > 100);
+  CHECK(wrong_by_beam * 5 < wrong_by_spread * 4);
+}
+
+TEST_CASE("Point labels: beam origins must name one origin per point") {
+  Corner corner;
+  std::vector<std::int32_t> labels = labelPoints(corner.map, corner.scan);
+  const std::vector<Point> origins{Point::Zero()};
+  const std::vector<std::uint32_t> too_few(3, 0);
+  CHECK_THROWS_AS(refinePointLabels(corner.map, corner.detection.planes, corner.scan.points, labels, corner.options(),
+                                    BeamOrigins{origins, too_few}),
+                  Error);
+  std::vector<std::uint32_t> out_of_range(corner.scan.size(), 0);
+  out_of_range.back() = 1;
+  CHECK_THROWS_AS(refinePointLabels(corner.map, corner.detection.planes, corner.scan.points, labels, corner.options(),
+                                    BeamOrigins{origins, out_of_range}),
+                  Error);
+}

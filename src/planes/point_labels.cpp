@@ -5,7 +5,9 @@
 #include <cmath>
 #include <limits>
 
+#include "mlmap/error.hpp"
 #include "pca_sums.hpp"
+#include <string>
 
 namespace mlmap {
 
@@ -39,6 +41,9 @@ namespace {
 // Point chunks of a fixed count, summed in chunk order: the same sums, bit for bit,
 // whatever the thread count.
 constexpr std::int64_t kChunks = 64;
+
+// Beams this close to grazing a plane rank as if at this cosine (about 87°).
+constexpr double kMinIncidenceCosine = 0.05;
 
 template <typename Accept>
 std::vector<PcaSums> patchMoments(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
@@ -93,7 +98,12 @@ double planeDistance(const PointPlane& plane, const Point& p) {
 
 std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plane> planes,
                                           std::span<const Point> points, std::span<std::int32_t> labels,
-                                          const PointLabelRefinement& options) {
+                                          const PointLabelRefinement& options, const BeamOrigins& beams) {
+  if (!beams.origin_of_point.empty() && beams.origin_of_point.size() != points.size())
+    throw Error("refinePointLabels: " + std::to_string(beams.origin_of_point.size()) + " beam origins for " +
+                std::to_string(points.size()) + " points");
+  for (const std::uint32_t origin : beams.origin_of_point)
+    if (origin >= beams.origins.size()) throw Error("refinePointLabels: a point's beam origin " + std::to_string(origin) + " is out of range");
   // Patches by slot 1..n in id order; slot 0 is "none". Ids come from a map file: a
   // patch id no plane has, or a plane id ≤ 0 or repeated, is none.
   std::vector<std::int32_t> ids;
@@ -150,16 +160,28 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     const auto index = static_cast<std::size_t>(k);
     const Point& p = points[index];
     // Near an edge a point lies within tolerance of two planes: the more likely one
-    // wins, i.e. the smaller distance in units of the plane's own spread (a floor seen
-    // at a grazing angle is far thinner than a wall seen head on), the collecting
-    // block's patch first among equals.
+    // wins, the collecting block's patch first among equals. With its beam known, that
+    // is the plane the beam meets nearer the measured range (range noise lies along the
+    // beam): the distance over the cosine of the beam's incidence. Else the smaller
+    // distance in units of the plane's own spread (a floor seen at a grazing angle is
+    // far thinner than a wall seen head on), which holds for the plane's typical beam
+    // but not for a point seen head on where the plane is mostly seen grazing.
     std::int32_t best_label = labels[index] < 0 ? -1 : 0;
     double best = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d beam = Eigen::Vector3d::Zero();
+    if (!beams.origin_of_point.empty()) {
+      const Eigen::Vector3d ray = p - beams.origins[beams.origin_of_point[index]];
+      const double length = ray.norm();
+      if (length > 0.0) beam = ray / length;
+    }
     const auto consider = [&](std::uint32_t slot) {
       const PointPlane& plane = fitted[slot];
-      const double distance = planeDistance(plane, p) / plane.tolerance;
-      if (distance <= 1.0 && distance < best) {
-        best = distance;
+      const double distance = planeDistance(plane, p);
+      if (distance > plane.tolerance) return;
+      const double rank = beam.isZero() ? distance / plane.tolerance
+                                        : distance / std::max(kMinIncidenceCosine, std::abs(plane.normal.dot(beam)));
+      if (rank < best) {
+        best = rank;
         best_label = plane.id;
       }
     };

@@ -32,17 +32,26 @@ struct PointPlane {  // a patch's plane refitted to its points
   std::size_t points = 0;   // points that fitted it
 };
 
+// Where each point's beam started (world frame): the scanner's position per scan, and
+// per point the index of its scan's. Empty: unknown.
+struct BeamOrigins {
+  std::span<const Point> origins;
+  std::span<const std::uint32_t> origin_of_point;
+};
+
 // Block labels are cell-sized: a block at a corner or an edge holds points of two
 // surfaces, and all of them take the block's patch. This pass refits every patch's
 // plane to its labelled points (first those within `band` of the detected plane, then
-// those within tolerance of the first fit); then every point takes the nearest of the patches it lies on (within
-// tolerance of the plane) among its block's and those of the blocks of its own and
-// the 8 neighbouring cells that reach its height, or none (0) if it lies on none.
+// those within tolerance of the first fit); then every point takes the nearest of the
+// patches it lies on (within tolerance of the plane) among its block's and those of
+// the blocks of its own and the 8 neighbouring cells that reach its height, or none (0)
+// if it lies on none. Nearest: along the point's beam when `beams` are given (range
+// noise lies along the beam), else in units of each plane's tolerance.
 // `labels` are labelPoints' (any value ≤ 0 is "none"); `points` are world points.
 // Returns the refitted planes in id order (ids ≤ 0 and repeats left out). Deterministic
 // at any thread count.
 std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plane> planes,
                                           std::span<const Point> points, std::span<std::int32_t> labels,
-                                          const PointLabelRefinement& options = {});
+                                          const PointLabelRefinement& options = {}, const BeamOrigins& beams = {});
 
 }  // namespace mlmap
