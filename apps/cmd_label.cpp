@@ -49,7 +49,9 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
     refinePointLabels(map.blocks(), map.planes()->planes, labelled.points, labelled.labels,
                       PointLabelRefinement{.noise = map.planes()->config.noise,
                                            .band = map.planes()->config.epsilon + 0.5 * map.blocks().cellSize()},
-                      BeamOrigins{scanner_positions, scan_of_point});
+                      // Without a pose file a scan's frame may be the world's, not its
+                      // scanner's: then where its beams started is unknown.
+                      arguments.poses.empty() ? BeamOrigins{} : BeamOrigins{scanner_positions, scan_of_point});
   for (std::int32_t& label : labelled.labels) {
     // Blocks without a plane and points no block collects are both "none" here.
     if (label <= 0) label = -1;
@@ -69,7 +71,9 @@ void addLabelCommand(CLI::App& app, Context& context) {
       "label", "Write every scan point in the world frame with the plane id of its block (x y z id, -1 for none)");
   command->add_option("map", arguments->map, "Labelled map (.mlmap, from mlmap planes -o)")
       ->required()->check(CLI::ExistingFile);
-  command->add_option("--poses", arguments->poses, "TUM pose file, one pose per scan in order");
+  command->add_option("--poses", arguments->poses,
+                      "TUM pose file, one pose per scan in order (its positions are the beams' origins, "
+                      "which decide between two planes near an edge)");
   command->add_option("-o,--output", arguments->output, "Points file to write (.xyz)")->required();
   command->add_option("scans", arguments->scans, "Scan files")->required()->check(CLI::ExistingFile);
   command->add_flag("--block-labels", arguments->block_labels,
