@@ -257,3 +257,29 @@ TEST_CASE("stableSortBy: a counting sort, or a stable sort for wide key ranges, 
     CHECK(items == expected);
   }
 }
+
+TEST_CASE("spreadExceeds: the same answer as comparing directionSpread, near the limit and far from it") {
+  test::PlaneSceneBuilder scene = patchScene();
+  scene.rectangle({1.5, 0.9, 0.0}, {0.5, 0.0, 0.3}, {0.0, 0.5, 0.0}, 0.01);  // a ramp, its edges bent
+  const BlockGrid grid(scene.map());
+  const std::vector<Eigen::Vector3f> directions = directionVectors(grid, DirectionConfig{});
+  PlaneScorer scorer(grid, directions, 0.05, 25.0 * std::numbers::pi / 180.0);
+  // Planes tilted off the blocks' directions, so the angles are neither 0 nor alike.
+  const std::vector<CandidatePlane> planes{{Eigen::Vector3f(0.05F, 0.0F, 1.0F).normalized(), {0.0F, 0.0F, 0.0F}},
+                                           {Eigen::Vector3f(0.0F, 0.2F, 1.0F).normalized(), {0.0F, 0.0F, 0.72F}},
+                                           {Eigen::Vector3f(1.0F, 0.1F, 0.0F).normalized(), {0.02F, 0.0F, 0.0F}},
+                                           {Eigen::Vector3f(-0.51F, 0.0F, 0.86F).normalized(), {1.5F, 0.9F, 0.0F}}};
+  std::size_t checked = 0;
+  for (const CandidatePlane& plane : planes) {
+    const std::vector<std::uint32_t> ids = scorer.matching(plane);
+    if (ids.empty()) continue;
+    const double spread = directionSpread(grid, directions, ids, plane);
+    for (const double limit : {0.0, spread * (1.0 - 1e-3), spread * (1.0 - 1e-12), spread, spread * (1.0 + 1e-12),
+                               spread * (1.0 + 1e-3), std::nextafter(spread, 0.0), std::nextafter(spread, 90.0), 90.0}) {
+      CHECK(spreadExceeds(grid, directions, ids, plane, limit) == (spread > limit));
+      ++checked;
+    }
+  }
+  CHECK(checked >= 18);
+  CHECK_FALSE(spreadExceeds(grid, directions, {}, planes[0], 0.0));  // no blocks: no spread
+}
