@@ -283,3 +283,31 @@ TEST_CASE("spreadExceeds: the same answer as comparing directionSpread, near the
   CHECK(checked >= 18);
   CHECK_FALSE(spreadExceeds(grid, directions, {}, planes[0], 0.0));  // no blocks: no spread
 }
+
+TEST_CASE("outlineOf: holes, and islands inside them, leave the outer boundary as it is") {
+  test::PlaneSceneBuilder scene(0.05, 0.0, 1);
+  scene.floor(0.0, 0.0, 0.98, 0.98, 0.0);  // 20 × 20 cells
+  const BlockGrid grid(scene.map());
+  const Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d point(0.0, 0.0, 0.0);
+  std::vector<std::uint32_t> all(grid.size());
+  std::iota(all.begin(), all.end(), std::uint32_t{0});
+  const std::vector<Eigen::Vector3d> full = outlineOf(grid, all, normal, point);
+  REQUIRE(full.size() == 4);
+  std::mt19937 random(9);
+  for (int trial = 0; trial < 5; ++trial) {
+    // Holes of one cell, cells touching at corners, and a ring round a one-cell island,
+    // all at least two cells inside the edge.
+    std::vector<std::uint32_t> kept;
+    for (const std::uint32_t id : all) {
+      const CellIndex cell = grid.blocks()[id].cell;
+      const int ring = std::max(std::abs(cell.i - 14), std::abs(cell.j - 14));
+      const bool inner = cell.i >= 2 && cell.i <= 17 && cell.j >= 2 && cell.j <= 17;
+      if (ring == 1 || (inner && ring > 2 && random() % 3 == 0)) continue;
+      kept.push_back(id);
+    }
+    const std::vector<Eigen::Vector3d> outline = outlineOf(grid, kept, normal, point);
+    REQUIRE(outline.size() == full.size());
+    for (std::size_t k = 0; k < full.size(); ++k) CHECK((outline[k] - full[k]).norm() < 1e-12);
+  }
+}
