@@ -207,8 +207,10 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
     tile_of_.push_back(static_cast<std::uint32_t>(tiles_.size() - 1));
     tiles_.back().end = static_cast<std::uint32_t>(k + 1);
   }
-  // The blocks' data in index order: a gather across the grid, on all threads.
-  const auto indexed = static_cast<std::int64_t>(order.size());
+  // The blocks' data in index order, on all threads: scattered from a pass over the
+  // grid in id order, which reads each block once and whole (a gather in index order
+  // read a block's cache lines twice over, once for the floor, once for the ceiling
+  // sharing its cells, and the blocks are far larger than what is kept of them).
   ids_.resize(order.size());
   points_.resize(order.size());
   block_directions_.resize(order.size());
@@ -216,9 +218,10 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   half_depths_.resize(order.size());
   order_taken_.assign(order.size(), 0);
 #pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
-  for (std::int64_t k = 0; k < indexed; ++k) {
-    const auto n = static_cast<std::size_t>(k);
-    const std::uint32_t id = order[n].id;
+  for (std::int64_t signed_id = 0; signed_id < count; ++signed_id) {
+    const auto id = static_cast<std::uint32_t>(signed_id);
+    const std::uint32_t n = position_[id];
+    if (n == UINT32_MAX) continue;
     const PlaneBlock& block = grid.blocks()[id];
     ids_[n] = id;
     points_[n] = block.point;
