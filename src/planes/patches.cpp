@@ -178,7 +178,9 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
   // the outer boundary, and a ceiling at 2 cm has tens of thousands of holes.
   std::vector<std::uint8_t> outside(static_cast<std::size_t>(raster.columns * raster.rows), 0);
   {
-    auto empty = [&](std::size_t slot) { return raster.slots[slot] < 0 || !inside(static_cast<std::size_t>(raster.slots[slot])); };
+    auto empty = [&](std::size_t slot) {
+      return raster.slots[slot] < 0 || !inside(static_cast<std::size_t>(raster.slots[slot]));
+    };
     const auto rows = static_cast<std::size_t>(raster.rows);
     const std::size_t cells = outside.size();
     std::vector<std::size_t> stack{0};
@@ -199,7 +201,9 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
     }
   }
   // Occupied cells never lie on the margin: their neighbours are all in the raster.
-  auto outer = [&](std::int64_t u, std::int64_t v) { return outside[static_cast<std::size_t>(&raster.at(u, v) - raster.slots.data())] != 0; };
+  auto outer = [&](std::int64_t u, std::int64_t v) {
+    return outside[static_cast<std::size_t>(&raster.at(u, v) - raster.slots.data())] != 0;
+  };
   auto addEdge = [&](const Eigen::Vector2i& from, const Eigen::Vector2i& to) {
     auto& slots = out[vertexOf(from.x(), from.y())];
     (slots[0] < 0 ? slots[0] : slots[1]) = static_cast<std::int32_t>(edge_from.size());
