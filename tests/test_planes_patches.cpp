@@ -257,3 +257,57 @@ TEST_CASE("stableSortBy: a counting sort, or a stable sort for wide key ranges, 
     CHECK(items == expected);
   }
 }
+
+TEST_CASE("spreadExceeds: the same answer as comparing directionSpread, near the limit and far from it") {
+  test::PlaneSceneBuilder scene = patchScene();
+  scene.rectangle({1.5, 0.9, 0.0}, {0.5, 0.0, 0.3}, {0.0, 0.5, 0.0}, 0.01);  // a ramp, its edges bent
+  const BlockGrid grid(scene.map());
+  const std::vector<Eigen::Vector3f> directions = directionVectors(grid, DirectionConfig{});
+  PlaneScorer scorer(grid, directions, 0.05, 25.0 * std::numbers::pi / 180.0);
+  // Planes tilted off the blocks' directions, so the angles are neither 0 nor alike.
+  const std::vector<CandidatePlane> planes{{Eigen::Vector3f(0.05F, 0.0F, 1.0F).normalized(), {0.0F, 0.0F, 0.0F}},
+                                           {Eigen::Vector3f(0.0F, 0.2F, 1.0F).normalized(), {0.0F, 0.0F, 0.72F}},
+                                           {Eigen::Vector3f(1.0F, 0.1F, 0.0F).normalized(), {0.02F, 0.0F, 0.0F}},
+                                           {Eigen::Vector3f(-0.51F, 0.0F, 0.86F).normalized(), {1.5F, 0.9F, 0.0F}}};
+  std::size_t checked = 0;
+  for (const CandidatePlane& plane : planes) {
+    const std::vector<std::uint32_t> ids = scorer.matching(plane);
+    if (ids.empty()) continue;
+    const double spread = directionSpread(grid, directions, ids, plane);
+    for (const double limit : {0.0, spread * (1.0 - 1e-3), spread * (1.0 - 1e-12), spread, spread * (1.0 + 1e-12),
+                               spread * (1.0 + 1e-3), std::nextafter(spread, 0.0), std::nextafter(spread, 90.0), 90.0}) {
+      CHECK(spreadExceeds(grid, directions, ids, plane, limit) == (spread > limit));
+      ++checked;
+    }
+  }
+  CHECK(checked >= 18);
+  CHECK_FALSE(spreadExceeds(grid, directions, {}, planes[0], 0.0));  // no blocks: no spread
+}
+
+TEST_CASE("outlineOf: holes, and islands inside them, leave the outer boundary as it is") {
+  test::PlaneSceneBuilder scene(0.05, 0.0, 1);
+  scene.floor(0.0, 0.0, 0.98, 0.98, 0.0);  // 20 × 20 cells
+  const BlockGrid grid(scene.map());
+  const Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d point(0.0, 0.0, 0.0);
+  std::vector<std::uint32_t> all(grid.size());
+  std::iota(all.begin(), all.end(), std::uint32_t{0});
+  const std::vector<Eigen::Vector3d> full = outlineOf(grid, all, normal, point);
+  REQUIRE(full.size() == 4);
+  std::mt19937 random(9);
+  for (int trial = 0; trial < 5; ++trial) {
+    // Holes of one cell, cells touching at corners, and a ring round a one-cell island,
+    // all at least two cells inside the edge.
+    std::vector<std::uint32_t> kept;
+    for (const std::uint32_t id : all) {
+      const CellIndex cell = grid.blocks()[id].cell;
+      const int ring = std::max(std::abs(cell.i - 14), std::abs(cell.j - 14));
+      const bool inner = cell.i >= 2 && cell.i <= 17 && cell.j >= 2 && cell.j <= 17;
+      if (ring == 1 || (inner && ring > 2 && random() % 3 == 0)) continue;
+      kept.push_back(id);
+    }
+    const std::vector<Eigen::Vector3d> outline = outlineOf(grid, kept, normal, point);
+    REQUIRE(outline.size() == full.size());
+    for (std::size_t k = 0; k < full.size(); ++k) CHECK((outline[k] - full[k]).norm() < 1e-12);
+  }
+}

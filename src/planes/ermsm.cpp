@@ -180,7 +180,7 @@ bool Detector::accept(std::size_t index) {
   }
   const double kappa = radians(config_.kappa_deg);
   const std::vector<std::uint32_t> strict = scorer_.matching(accepted.plane);
-  if (directionSpread(grid_, directions_, strict, accepted.plane) > config_.max_direction_spread_deg) {
+  if (spreadExceeds(grid_, directions_, strict, accepted.plane, config_.max_direction_spread_deg)) {
     refused_.push_back(accepted.plane);
     drop(index);
     return false;

@@ -26,6 +26,11 @@ std::vector<std::uint32_t> withEdges(const BlockGrid& grid, const std::vector<Ei
 // in degrees, of the blocks' directions to the normal, weighted by surface.
 double directionSpread(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                        const std::vector<std::uint32_t>& ids, const CandidatePlane& plane);
+// Whether directionSpread(...) > max_deg, decided from cheap bounds of each angle where
+// they settle it (nearly always: the ceiling's 150 000 angles cost an arc cosine each),
+// else from directionSpread itself: the same answer either way.
+bool spreadExceeds(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
+                   const std::vector<std::uint32_t>& ids, const CandidatePlane& plane, double max_deg);
 
 // A patch one cell wide is no surface: it is the fringe of a wall standing on a cell
 // boundary (stray points in the next column) or a line of clutter. True when its blocks

@@ -169,13 +169,40 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
   // as a ceiling's hundreds of thousands of sides come in.
   edge_from.reserve(4 * raster.cells.size());
   edge_to.reserve(4 * raster.cells.size());
-  auto occupied = [&](std::int64_t u, std::int64_t v) {
-    if (u < raster.min_u - raster.margin || v < raster.min_v - raster.margin ||
-        u >= raster.min_u - raster.margin + raster.columns || v >= raster.min_v - raster.margin + raster.rows) {
-      return false;
+  // The empty cells the outside reaches through empty cells side by side (the raster's
+  // margin is empty: all of it, from its first cell). Only the sides facing them are
+  // traced: a loop keeps one empty region on its right all the way round (where cells
+  // touch at a corner it turns into the other cell's boundary, not across to the
+  // other region), so sides facing a hole only make loops round holes, clockwise, or
+  // round islands inside holes, smaller than the loop round the hole: neither is ever
+  // the outer boundary, and a ceiling at 2 cm has tens of thousands of holes.
+  std::vector<std::uint8_t> outside(static_cast<std::size_t>(raster.columns * raster.rows), 0);
+  {
+    auto empty = [&](std::size_t slot) {
+      return raster.slots[slot] < 0 || !inside(static_cast<std::size_t>(raster.slots[slot]));
+    };
+    const auto rows = static_cast<std::size_t>(raster.rows);
+    const std::size_t cells = outside.size();
+    std::vector<std::size_t> stack{0};
+    outside[0] = 1;
+    auto reach = [&](std::size_t slot) {
+      if (outside[slot] == 0 && empty(slot)) {
+        outside[slot] = 1;
+        stack.push_back(slot);
+      }
+    };
+    while (!stack.empty()) {
+      const std::size_t slot = stack.back();
+      stack.pop_back();
+      if (slot % rows != 0) reach(slot - 1);
+      if (slot % rows != rows - 1) reach(slot + 1);
+      if (slot >= rows) reach(slot - rows);
+      if (slot + rows < cells) reach(slot + rows);
     }
-    const std::int32_t slot = raster.at(u, v);
-    return slot >= 0 && inside(static_cast<std::size_t>(slot));
+  }
+  // Occupied cells never lie on the margin: their neighbours are all in the raster.
+  auto outer = [&](std::int64_t u, std::int64_t v) {
+    return outside[static_cast<std::size_t>(&raster.at(u, v) - raster.slots.data())] != 0;
   };
   auto addEdge = [&](const Eigen::Vector2i& from, const Eigen::Vector2i& to) {
     auto& slots = out[vertexOf(from.x(), from.y())];
@@ -187,10 +214,10 @@ std::vector<Eigen::Vector2i> outerBoundary(PlaneRaster& raster, Inside&& inside)
     if (!inside(n)) continue;
     const int u = raster.cells[n].x();
     const int v = raster.cells[n].y();
-    if (!occupied(u, v - 1)) addEdge({u, v}, {u + 1, v});
-    if (!occupied(u + 1, v)) addEdge({u + 1, v}, {u + 1, v + 1});
-    if (!occupied(u, v + 1)) addEdge({u + 1, v + 1}, {u, v + 1});
-    if (!occupied(u - 1, v)) addEdge({u, v + 1}, {u, v});
+    if (outer(u, v - 1)) addEdge({u, v}, {u + 1, v});
+    if (outer(u + 1, v)) addEdge({u + 1, v}, {u + 1, v + 1});
+    if (outer(u, v + 1)) addEdge({u + 1, v + 1}, {u, v + 1});
+    if (outer(u - 1, v)) addEdge({u, v + 1}, {u, v});
   }
   std::vector<std::uint8_t> used(edge_from.size(), 0);
   auto before = [](const Eigen::Vector2i& a, const Eigen::Vector2i& b) {

@@ -207,8 +207,10 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
     tile_of_.push_back(static_cast<std::uint32_t>(tiles_.size() - 1));
     tiles_.back().end = static_cast<std::uint32_t>(k + 1);
   }
-  // The blocks' data in index order: a gather across the grid, on all threads.
-  const auto indexed = static_cast<std::int64_t>(order.size());
+  // The blocks' data in index order, on all threads: scattered from a pass over the
+  // grid in id order, which reads each block once and whole (a gather in index order
+  // read a block's cache lines twice over, once for the floor, once for the ceiling
+  // sharing its cells, and the blocks are far larger than what is kept of them).
   ids_.resize(order.size());
   points_.resize(order.size());
   block_directions_.resize(order.size());
@@ -216,9 +218,10 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   half_depths_.resize(order.size());
   order_taken_.assign(order.size(), 0);
 #pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
-  for (std::int64_t k = 0; k < indexed; ++k) {
-    const auto n = static_cast<std::size_t>(k);
-    const std::uint32_t id = order[n].id;
+  for (std::int64_t signed_id = 0; signed_id < count; ++signed_id) {
+    const auto id = static_cast<std::uint32_t>(signed_id);
+    const std::uint32_t n = position_[id];
+    if (n == UINT32_MAX) continue;
     const PlaneBlock& block = grid.blocks()[id];
     ids_[n] = id;
     points_[n] = block.point;
@@ -248,46 +251,61 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
     // A little slack for the float rounding of the frame change.
     node.half_extent = 0.5F * (high - low) + Eigen::Vector3f::Constant(1e-5F);
   };
-  // Each node on its own, so on all threads.
-  const auto tile_count_signed = static_cast<std::int64_t>(tiles_.size());
-#pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
-  for (std::int64_t t = 0; t < tile_count_signed; ++t) {
-    Node& tile = tiles_[static_cast<std::size_t>(t)];
-    describe(tile, frames_[bin_of_layer_[layer_of_tile_[static_cast<std::size_t>(t)]]], tile.begin, tile.end);
-  }
+  // Each node on its own, so on all threads, in one parallel region: the bins first
+  // (the polar one holds the floors and ceilings, most blocks of a building), the
+  // layers and tiles shared out while a thread goes through it. A tile's sums follow
+  // its description, its blocks still in cache.
+  const auto bin_count_signed = static_cast<std::int64_t>(bins);
   const auto layer_count_signed = static_cast<std::int64_t>(layers_.size());
-#pragma omp parallel for schedule(dynamic, 16) num_threads(team) if (team > 1)
-  for (std::int64_t l = 0; l < layer_count_signed; ++l) {
-    Node& layer = layers_[static_cast<std::size_t>(l)];
-    describe(layer, frames_[bin_of_layer_[static_cast<std::size_t>(l)]], tiles_[layer.begin].begin, tiles_[layer.end - 1].end);
-  }
-  for (std::size_t b = 0; b < bins; ++b) {
-    Node& bin = bins_[b];
-    if (bin.begin == bin.end) continue;
-    describe(bin, frames_[b], tiles_[layers_[bin.begin].begin].begin, tiles_[layers_[bin.end - 1].end - 1].end);
+  const auto tile_count_signed = static_cast<std::int64_t>(tiles_.size());
+#pragma omp parallel num_threads(team) if (team > 1)
+  {
+#pragma omp for schedule(dynamic, 1) nowait
+    for (std::int64_t b = 0; b < bin_count_signed; ++b) {
+      Node& bin = bins_[static_cast<std::size_t>(b)];
+      if (bin.begin == bin.end) continue;
+      describe(bin, frames_[static_cast<std::size_t>(b)], tiles_[layers_[bin.begin].begin].begin,
+               tiles_[layers_[bin.end - 1].end - 1].end);
+    }
+#pragma omp for schedule(dynamic, 16) nowait
+    for (std::int64_t l = 0; l < layer_count_signed; ++l) {
+      Node& layer = layers_[static_cast<std::size_t>(l)];
+      describe(layer, frames_[bin_of_layer_[static_cast<std::size_t>(l)]], tiles_[layer.begin].begin,
+               tiles_[layer.end - 1].end);
+    }
+#pragma omp for schedule(dynamic, 64)
+    for (std::int64_t t = 0; t < tile_count_signed; ++t) {
+      Node& tile = tiles_[static_cast<std::size_t>(t)];
+      describe(tile, frames_[bin_of_layer_[layer_of_tile_[static_cast<std::size_t>(t)]]], tile.begin, tile.end);
+      sumTile(tile);
+    }
   }
   std::vector<std::uint32_t> all_tiles(tiles_.size());
   for (std::uint32_t t = 0; t < tiles_.size(); ++t) all_tiles[t] = t;
-  refresh(all_tiles, team);
+  sumLayersAndBins(all_tiles);
 }
 
-// Recomputes the sums of the given tiles (ascending) and of their layers and bins;
-// the tiles' on `threads` threads (each on its own).
-void PlaneScorer::refresh(const std::vector<std::uint32_t>& tiles, int threads) {
-  const auto tile_count = static_cast<std::int64_t>(tiles.size());
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-  for (std::int64_t n = 0; n < tile_count; ++n) {
-    Node& tile = tiles_[tiles[static_cast<std::size_t>(n)]];
-    tile.untaken = 0;
-    tile.surface = 0.0;
-    tile.pca = PcaSums{};
-    for (std::uint32_t k = tile.begin; k < tile.end; ++k) {
-      if (order_taken_[k] != 0) continue;
-      ++tile.untaken;
-      tile.surface += surfaces_[k];
-      tile.pca.addBlock((points_[k] - tile.centre).cast<double>(), half_depths_[k], surfaces_[k]);
-    }
+// The sums of the tile's untaken blocks.
+void PlaneScorer::sumTile(Node& tile) const {
+  tile.untaken = 0;
+  tile.surface = 0.0;
+  tile.pca = PcaSums{};
+  for (std::uint32_t k = tile.begin; k < tile.end; ++k) {
+    if (order_taken_[k] != 0) continue;
+    ++tile.untaken;
+    tile.surface += surfaces_[k];
+    tile.pca.addBlock((points_[k] - tile.centre).cast<double>(), half_depths_[k], surfaces_[k]);
   }
+}
+
+// Recomputes the sums of the given tiles (ascending) and of their layers and bins.
+void PlaneScorer::refresh(const std::vector<std::uint32_t>& tiles) {
+  for (const std::uint32_t t : tiles) sumTile(tiles_[t]);
+  sumLayersAndBins(tiles);
+}
+
+// The sums of the layers and bins of the given tiles (ascending), from their tiles'.
+void PlaneScorer::sumLayersAndBins(const std::vector<std::uint32_t>& tiles) {
   std::vector<std::uint32_t> layers;
   for (const std::uint32_t t : tiles) {
     if (layers.empty() || layers.back() != layer_of_tile_[t]) layers.push_back(layer_of_tile_[t]);
@@ -471,7 +489,7 @@ void PlaneScorer::take(const std::vector<std::uint32_t>& ids) {
     order_taken_[k] = 1;
     dirty.insert(tile_of_[k]);
   }
-  refresh(dirty.ascending(), 1);
+  refresh(dirty.ascending());
 }
 
 }  // namespace mlmap

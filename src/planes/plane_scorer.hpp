@@ -74,7 +74,9 @@ class PlaneScorer {
   enum class Slab { Outside, Cut, Inside };
   struct Query;
 
-  void refresh(const std::vector<std::uint32_t>& tiles, int threads);
+  void sumTile(Node& tile) const;
+  void refresh(const std::vector<std::uint32_t>& tiles);
+  void sumLayersAndBins(const std::vector<std::uint32_t>& tiles);
   void collect(const Query& query, const Query* except, IdSet& ids) const;
 
   const BlockGrid& grid_;
