@@ -92,7 +92,8 @@ std::vector<Eigen::Vector3f> scalarDirections(const BlockGrid& grid, int radius,
         Eigen::Matrix2d covariance;
         covariance << xx, xy, xy, yy;
         covariance = covariance / n - mean * mean.transpose();
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(covariance);
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver;
+        solver.computeDirect(covariance);
         if (solver.eigenvalues()(1) < min_spread) continue;
         const Eigen::Vector2d normal = solver.eigenvectors().col(0);
         directions[id] = orientConsistently(Eigen::Vector3f(static_cast<float>(normal.x()), static_cast<float>(normal.y()), 0.0F));

@@ -84,7 +84,8 @@ Eigen::Vector3f verticalDirection(const PlaneBlock& self, const std::vector<Neig
   Eigen::Matrix2d covariance;
   covariance << plane[3], cross[0], cross[0], cross[1];
   covariance = covariance / n - mean * mean.transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(covariance);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver;
+  solver.computeDirect(covariance);
   if (solver.eigenvalues()(1) < min_spread) return Eigen::Vector3f::Zero();
   const Eigen::Vector2d normal = solver.eigenvectors().col(0);
   return orientConsistently(Eigen::Vector3f(static_cast<float>(normal.x()), static_cast<float>(normal.y()), 0.0F));
