@@ -9,9 +9,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "mlmap/error.hpp"
 #include "mlmap/scan.hpp"
@@ -118,6 +120,32 @@ inline Scan randomScan(std::size_t count, unsigned seed, double extent,
     if (labels) scan.labels.push_back(label(generator));
   }
   return scan;
+}
+
+// Per-point plane labels against the truth: of the points with a patch (label > 0),
+// how many there are, and how many lie on the true plane most of their patch's points
+// lie on (all of them when every patch holds one surface only).
+struct LabelAgreement {
+  std::size_t labelled = 0;
+  std::size_t on_majority = 0;
+  std::size_t misplaced() const { return labelled - on_majority; }
+};
+
+inline LabelAgreement labelAgreement(const std::vector<std::int32_t>& predicted, const std::vector<std::int32_t>& truth) {
+  REQUIRE(predicted.size() == truth.size());
+  std::map<std::int32_t, std::map<std::int32_t, std::size_t>> counts;  // patch -> true plane -> points
+  for (std::size_t k = 0; k < predicted.size(); ++k)
+    if (predicted[k] > 0) ++counts[predicted[k]][truth[k]];
+  LabelAgreement agreement;
+  for (const auto& [patch, by_truth] : counts) {
+    std::size_t best = 0;
+    for (const auto& [plane, count] : by_truth) {
+      best = std::max(best, count);
+      agreement.labelled += count;
+    }
+    agreement.on_majority += best;
+  }
+  return agreement;
 }
 
 // Largest |read - written| / |written| over the points, which must match in number.

@@ -3,7 +3,6 @@
 #include <doctest/doctest.h>
 
 #include <fstream>
-#include <map>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
@@ -133,20 +132,9 @@ namespace {
 // Of the points with a patch, the share whose true plane is the one most of their
 // patch's points lie on: 1 when every patch holds points of one surface only.
 double labelPurity(const std::vector<std::int32_t>& predicted, const std::vector<std::int32_t>& truth) {
-  std::map<std::int32_t, std::map<std::int32_t, std::size_t>> counts;  // patch -> true plane -> points
-  for (std::size_t k = 0; k < predicted.size(); ++k)
-    if (predicted[k] > 0) ++counts[predicted[k]][truth[k]];
-  std::size_t majority = 0;
-  std::size_t total = 0;
-  for (const auto& [patch, by_truth] : counts) {
-    std::size_t best = 0;
-    for (const auto& [plane, count] : by_truth) {
-      best = std::max(best, count);
-      total += count;
-    }
-    majority += best;
-  }
-  return total == 0 ? 0.0 : static_cast<double>(majority) / static_cast<double>(total);
+  const mlmap::test::LabelAgreement agreement = mlmap::test::labelAgreement(predicted, truth);
+  return agreement.labelled == 0 ? 0.0
+                                 : static_cast<double>(agreement.on_majority) / static_cast<double>(agreement.labelled);
 }
 
 }  // namespace

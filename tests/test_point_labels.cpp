@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <map>
 #include <random>
 #include <string>
 
@@ -16,6 +15,7 @@
 #include "mlmap/planes/ermsm.hpp"
 #include "mlmap/planes/point_labels.hpp"
 #include "mlmap/sim/simulator.hpp"
+#include "helpers.hpp"
 #include "room_scenes.hpp"
 
 using namespace mlmap;
@@ -179,25 +179,13 @@ TEST_CASE("Point labels: with the beams' origins, fewer points at edges take the
                                      .band = detection.config.epsilon + 0.5 * map.cellSize()};
   Scan all;
   all.points = points;
-  // Points on a true surface whose patch is mostly another surface's.
-  const auto misplaced = [&](const std::vector<std::int32_t>& labels) {
-    std::map<std::int32_t, std::map<std::int32_t, int>> votes;
-    for (std::size_t k = 0; k < points.size(); ++k)
-      if (labels[k] > 0 && truth[k] >= 0) ++votes[labels[k]][truth[k]];
-    int wrong = 0;
-    for (const auto& [patch, by_truth] : votes) {
-      const auto majority = std::max_element(by_truth.begin(), by_truth.end(),
-                                             [](const auto& a, const auto& b) { return a.second < b.second; });
-      for (const auto& [surface, count] : by_truth) wrong += surface == majority->first ? 0 : count;
-    }
-    return wrong;
-  };
   std::vector<std::int32_t> by_spread = labelPoints(map, all);
   refinePointLabels(map, detection.planes, points, by_spread, options);
   std::vector<std::int32_t> by_beam = labelPoints(map, all);
   refinePointLabels(map, detection.planes, points, by_beam, options, BeamOrigins{scanners, scanner_of_point});
-  const int wrong_by_spread = misplaced(by_spread);
-  const int wrong_by_beam = misplaced(by_beam);
+  // Points on a patch that is mostly another surface's.
+  const std::size_t wrong_by_spread = test::labelAgreement(by_spread, truth).misplaced();
+  const std::size_t wrong_by_beam = test::labelAgreement(by_beam, truth).misplaced();
   MESSAGE(points.size() << " points; on another surface's patch: " << wrong_by_spread << " ranked by spread, "
                         << wrong_by_beam << " by beam");
   REQUIRE(wrong_by_spread > 100);

@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "mlmap/error.hpp"
 #include "pca_sums.hpp"
-#include <string>
 
 namespace mlmap {
 
@@ -103,7 +103,8 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     throw Error("refinePointLabels: " + std::to_string(beams.origin_of_point.size()) + " beam origins for " +
                 std::to_string(points.size()) + " points");
   for (const std::uint32_t origin : beams.origin_of_point)
-    if (origin >= beams.origins.size()) throw Error("refinePointLabels: a point's beam origin " + std::to_string(origin) + " is out of range");
+    if (origin >= beams.origins.size())
+      throw Error("refinePointLabels: a point's beam origin " + std::to_string(origin) + " is out of range");
   // Patches by slot 1..n in id order; slot 0 is "none". Ids come from a map file: a
   // patch id no plane has, or a plane id ≤ 0 or repeated, is none.
   std::vector<std::int32_t> ids;
