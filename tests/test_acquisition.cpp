@@ -2,6 +2,7 @@
 // against it, scans checked against the scene's surfaces; injected faults; replay.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -33,16 +34,16 @@ const char* const kRoom = R"({
 
 mlmap::sim::Scene room() { return mlmap::sim::parseScene(kRoom, "room.json"); }
 
-// Distance from `point` to the nearest surface of the scene (brute force).
+// Distance from `point` to the nearest surface of the scene (brute force), to the
+// closest point of each rectangle: range noise on a beam that grazes a corner puts the
+// point beside both faces, where a distance to the planes alone would skip them.
 double surfaceDistance(const mlmap::sim::Scene& scene, const Eigen::Vector3d& point) {
   double best = 1e9;
   for (const auto& surface : scene.surfaces) {
-    const Eigen::Vector3d normal = surface.edge_u.cross(surface.edge_v).normalized();
     const Eigen::Vector3d relative = point - surface.corner;
-    const double s = relative.dot(surface.edge_u) / surface.edge_u.squaredNorm();
-    const double t = relative.dot(surface.edge_v) / surface.edge_v.squaredNorm();
-    if (s < -0.01 || s > 1.01 || t < -0.01 || t > 1.01) continue;
-    best = std::min(best, std::abs(relative.dot(normal)));
+    const double s = std::clamp(relative.dot(surface.edge_u) / surface.edge_u.squaredNorm(), 0.0, 1.0);
+    const double t = std::clamp(relative.dot(surface.edge_v) / surface.edge_v.squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (relative - s * surface.edge_u - t * surface.edge_v).norm());
   }
   return best;
 }
@@ -176,11 +177,12 @@ TEST_CASE("Driver end to end: 1 cm range noise, laser over loopback TCP") {
     return;
   }
   // Gaussian range noise of σ = 1 cm, seen obliquely (so a little less along the
-  // normals); 4.6 % of the ranges are off by more than 2σ. Timing errors would add.
+  // normals); 4.6 % of the ranges are off by more than 2σ. Timing errors add, up to
+  // the driver's bound.
   CHECK(distances.rms > 0.006);
   CHECK(distances.rms < 0.011);
   CHECK(distances.beyond_2cm < 0.07);
-  CHECK(distances.worst < 0.06);
+  CHECK(distances.worst < 0.06 + tilt_speed * run.result.sync_uncertainty_s * 7.0);  // 6σ + timing at 7 m
 }
 
 TEST_CASE("Driver faults: bad checksums and dropped lines are dropped, the scan recovers") {
