@@ -4,6 +4,7 @@ scored against the simulator's ground truth, beside the peer detectors when buil
 
     /usr/bin/python3 bench/planes_bench.py [--build build] [--peers PEERS_BUILD_DIR]
         [--scenes lab,corridor] [--cells lab:0.02,0.05,0.1;corridor:0.05,0.1] [--out out/bench]
+        [--cuts 0,300,1000]
 
 For every scene: simulate it (true poses, 1 cm range noise), and for every cell size build
 the block layer, detect planes, label every point and score the labels with
@@ -83,6 +84,9 @@ def main():
                     help="scenes of maps/; NAME-sparse is NAME scanned 5x more coarsely (tilt step 2 deg, 0.5 deg per beam)")
     ap.add_argument("--cells", default="lab:0.02,0.05,0.1;corridor:0.05,0.1;lab-sparse:0.05")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench"))
+    ap.add_argument("--cuts", default="",
+                    help="also score every map with these --min-gt-points cuts (e.g. 0,300,1000): "
+                         "how the patch figures depend on which small true faces count")
     a = ap.parse_args()
     if not os.path.exists(os.path.join(SHARED_PEERS, "score.py")):
         sys.exit("planes_bench: needs ../shared/peers/score.py beside the checkout")
@@ -126,7 +130,9 @@ def main():
                              candidates=J["detection"]["candidates"], detect_s=J["timings"]["total_s"],
                              build_s=build_s, **{k: s[k] for k in ("precision", "recall", "f1", "mean_normal_error_deg")},
                              hoover=s["hoover"]["correct"], gt=s["gt_planes"], f1_dc=s_dc["f1"], ignored=ignored,
-                             found=found, structural=structural))
+                             found=found, structural=structural,
+                             cuts=[(int(c), score(gt, lab, planes_true, min_gt_points=int(c)))
+                                   for c in a.cuts.split(",") if c]))
             total = J["map"]["blocks"]
             firsts = {}
             for p in J["planes"]:
@@ -159,6 +165,14 @@ def main():
               f"{r['detect_s']:.3f} | {r['precision']:.2f} | {r['recall']:.2f} | {r['f1']:.2f} | {r['f1_dc']:.2f} ({r['ignored']}) | "
               f"{r['hoover']} / {r['gt']} | "
               f"{r['mean_normal_error_deg']:.2f} | {r['found']} / {r['structural']} |")
+    if a.cuts:
+        print("\nPatch figures by the scorer's --min-gt-points cut (true faces with fewer points are left "
+              "out, and so are patches touching none of the kept ones): P / R / F1 (true faces kept)")
+        print("| scene-cell | " + " | ".join(f"cut {c}" for c, _ in rows[0]["cuts"]) + " |")
+        print("|---|" + "---|" * len(rows[0]["cuts"]))
+        for r in rows:
+            print(f"| {r['tag']} | " + " | ".join(f"{s['precision']:.2f} / {s['recall']:.2f} / {s['f1']:.2f} ({s['gt_planes']})"
+                                                  for _, s in r["cuts"]) + " |")
     print("\nCandidates before acceptance, eRMSM vs eq. 7 for eRANSAC (p_t = 0.99, over blocks):")
     print("| map | plane | class | blocks | of | eRMSM | eRANSAC eq. 7 |")
     print("|---|---|---|---|---|---|---|")
