@@ -177,12 +177,11 @@ TEST_CASE("Driver end to end: 1 cm range noise, laser over loopback TCP") {
     return;
   }
   // Gaussian range noise of σ = 1 cm, seen obliquely (so a little less along the
-  // normals); 4.6 % of the ranges are off by more than 2σ. Timing errors add, up to
-  // the driver's bound.
+  // normals); 4.6 % of the ranges are off by more than 2σ. Timing errors would add.
   CHECK(distances.rms > 0.006);
   CHECK(distances.rms < 0.011);
   CHECK(distances.beyond_2cm < 0.07);
-  CHECK(distances.worst < 0.06 + tilt_speed * run.result.sync_uncertainty_s * 7.0);  // 6σ + timing at 7 m
+  CHECK(distances.worst < 0.06);
 }
 
 TEST_CASE("Driver faults: bad checksums and dropped lines are dropped, the scan recovers") {
