@@ -65,11 +65,8 @@ def main():
             run([mlmap, "-q", "build", "-o", map_file, "--cell-size", str(cell), "--no-octree"] + options + scans)
             run([mlmap, "-q", "planes", map_file, "--threads", "2", "--json", planes_file])
             planes = json.load(open(planes_file))
-            info = run([mlmap, "info", map_file]).stdout
-            blocks_line = next(line for line in info.splitlines() if line.strip().startswith("blocks"))
-            # "blocks  N (H horizontal, V vertical, ...)"
-            words = blocks_line.replace("(", " ").replace(",", " ").split()
-            blocks, vertical = int(words[1]), int(words[words.index("vertical") - 1])
+            counts = json.loads(run([mlmap, "info", "--json", map_file]).stdout)["blocks"]
+            blocks, vertical = counts["total"], counts["vertical"]
             area = collections.defaultdict(float)
             for plane in planes["planes"]:
                 area[plane["label"]] += plane["area"]
