@@ -131,7 +131,7 @@ def main():
                              build_s=build_s, **{k: s[k] for k in ("precision", "recall", "f1", "mean_normal_error_deg")},
                              hoover=s["hoover"]["correct"], gt=s["gt_planes"], f1_dc=s_dc["f1"], ignored=ignored,
                              found=found, structural=structural,
-                             cuts=[(int(c), score(gt, lab, planes_true, min_gt_points=int(c)))
+                             cuts=[(int(c), s if int(c) == min_gt else score(gt, lab, planes_true, min_gt_points=int(c)))
                                    for c in a.cuts.split(",") if c]))
             total = J["map"]["blocks"]
             firsts = {}
