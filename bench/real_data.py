@@ -52,6 +52,8 @@ def main():
         return
     os.makedirs(a.out, exist_ok=True)
     mlmap = os.path.join(a.build, "mlmap")
+    if not os.access(mlmap, os.X_OK):
+        raise SystemExit(f"real_data: no mlmap CLI at {mlmap} (build it first, or give --build)")
     sets = data_sets(a.data, a.out)
     if not sets:
         print(f"real_data: skipped, none of the data sets is in {a.data}")
