@@ -3,11 +3,13 @@
 #include <doctest/doctest.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstring>
 #include <random>
 
 #include "../src/planes/plane_scorer.hpp"
+#include "../src/planes/smallest_axis.hpp"
 #include "mlmap/planes/block_grid.hpp"
 #include "mlmap/planes/direction_vectors.hpp"
 #include "mlmap/planes/ermsm.hpp"
@@ -295,20 +297,63 @@ TEST_CASE("eRMSM: a wall seen by scan lines 12 cm apart at 5 cm cells is found, 
   CHECK(found[0].area > 0.8 * 3.0 * 2.3);
 }
 
-TEST_CASE("directionVectors: bit for bit the directions of a scalar pass with Eigen's solvers, at 1 and 2 threads") {
+TEST_CASE("directionVectors: the directions of a scalar pass with Eigen's solvers, bit for bit at 1 and 2 threads") {
   test::PlaneSceneBuilder scene = scorerScene();
   const BlockGrid grid(scene.map());
   const std::vector<Eigen::Vector3f> expected = scalarDirections(grid, 2, 0.05F);
   std::size_t directed = 0;
   for (const Eigen::Vector3f& direction : expected) directed += direction.squaredNorm() > 0.0F ? 1 : 0;
   REQUIRE(directed > grid.size() / 2);
+  std::vector<std::vector<Eigen::Vector3f>> runs;
   for (const int threads : {1, 2}) {
     DirectionConfig config;
     config.height_tolerance = 0.05F;
     config.threads = threads;
-    const std::vector<Eigen::Vector3f> directions = directionVectors(grid, config);
-    REQUIRE(directions.size() == expected.size());
-    CHECK(std::memcmp(directions.data(), expected.data(), directions.size() * sizeof(Eigen::Vector3f)) == 0);
+    runs.push_back(directionVectors(grid, config));
+  }
+  REQUIRE(runs[0].size() == expected.size());
+  // The level blocks' axes come from smallestAxis, not computeDirect: equal up to rounding.
+  double worst = 0.0;
+  std::size_t mismatched = 0;
+  for (std::size_t id = 0; id < expected.size(); ++id) {
+    const bool has = runs[0][id].squaredNorm() > 0.0F;
+    if (has != (expected[id].squaredNorm() > 0.0F)) ++mismatched;
+    if (has && expected[id].squaredNorm() > 0.0F) {
+      worst = std::max(worst, static_cast<double>((runs[0][id] - expected[id]).norm()));
+    }
+  }
+  CHECK(mismatched == 0);
+  CHECK(worst < 1e-5);
+  CHECK(std::memcmp(runs[0].data(), runs[1].data(), runs[0].size() * sizeof(Eigen::Vector3f)) == 0);
+}
+
+TEST_CASE("smallestAxis: Eigen's smallest eigenvector and middle eigenvalue, surfaces and degenerate spreads alike") {
+  std::mt19937 random(7);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  // Covariances R·diag(λ)·Rᵀ: a level surface's (λ far apart), a line's and a blob's
+  // (the two smallest equal: computeDirect's answer), a point's (all zero).
+  const std::vector<Eigen::Vector3d> spectra{{1e-6, 4e-4, 4e-4}, {1e-8, 1e-4, 9e-4}, {0.0, 0.02, 0.03},
+                                             {2e-4, 2e-4, 8e-4}, {1e-4, 1e-4, 1e-4}, {0.0, 0.0, 0.0}};
+  for (const Eigen::Vector3d& spectrum : spectra) {
+    for (int trial = 0; trial < 50; ++trial) {
+      const Eigen::Quaterniond rotation =
+          Eigen::Quaterniond(normal(random), normal(random), normal(random), normal(random)).normalized();
+      const Eigen::Matrix3d turn = rotation.toRotationMatrix();
+      const Eigen::Matrix3d covariance = turn * spectrum.asDiagonal() * turn.transpose();
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+      solver.computeDirect(covariance);
+      const SmallestAxis smallest = smallestAxis(covariance);
+      CAPTURE(spectrum.transpose());
+      CHECK(std::abs(smallest.axis.norm() - 1.0) < 1e-12);
+      // Of two equal eigenvalues, both solvers take a square root of a discriminant near
+      // zero: 1e-8 relative apart at worst.
+      CHECK(std::abs(smallest.middle_eigenvalue - solver.eigenvalues()(1)) <= 1e-7 * std::max(spectrum(2), 1e-12));
+      // The axis is only defined when the smallest eigenvalue stands apart.
+      if (spectrum(1) - spectrum(0) > 1e-3 * spectrum(2)) {
+        CHECK(std::abs(smallest.axis.dot(solver.eigenvectors().col(0))) > 1.0 - 1e-12);
+        CHECK(std::abs(smallest.axis.dot(turn.col(0))) > 1.0 - 1e-9);
+      }
+    }
   }
 }
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "smallest_axis.hpp"
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -64,11 +66,10 @@ Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const std::vector<Ne
   Eigen::Matrix3d covariance;
   covariance << plane[3], cross[0], height[1], cross[0], cross[1], height[2], height[1], height[2], height[3];
   covariance = covariance / n - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  solver.computeDirect(covariance);
+  const SmallestAxis smallest = smallestAxis(covariance);
   // The neighbourhood must spread in two directions, or its normal is arbitrary.
-  if (solver.eigenvalues()(1) < min_spread) return Eigen::Vector3f::Zero();
-  return orientConsistently(solver.eigenvectors().col(0).cast<float>());
+  if (smallest.middle_eigenvalue < min_spread) return Eigen::Vector3f::Zero();
+  return orientConsistently(smallest.axis.cast<float>());
 }
 
 Eigen::Vector3f verticalDirection(const PlaneBlock& self, const std::vector<Neighbour>& vertical, double min_spread) {
