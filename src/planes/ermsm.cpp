@@ -42,6 +42,16 @@ double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 // milliseconds, and on a shared machine a parallel region can wait as long for a core.
 int patchPassThreads(const BlockGrid& grid, int threads) { return grid.size() < 100000 ? 1 : threads; }
 
+// The threads an OpenMP region of `threads` (0: OpenMP's default) gets.
+int teamSize(int threads) {
+#ifdef _OPENMP
+  return threads > 0 ? threads : omp_get_max_threads();
+#else
+  (void)threads;
+  return 1;
+#endif
+}
+
 // The range noise of the map's points: a vertical block keeps the variance of its
 // top measurement (section IV), so their median is a measurement's. 1 cm without any.
 double rangeNoise(const MLMap& map) {
@@ -64,7 +74,8 @@ class Detector {
         directions_(directions),
         config_(config),
         scorer_(grid, directions, config.epsilon, radians(config.kappa_deg), config.threads),
-        min_score_(config.min_area / (grid.cellSize() * grid.cellSize())) {
+        min_score_(config.min_area / (grid.cellSize() * grid.cellSize())),
+        patch_threads_(teamSize(patchPassThreads(grid, config.threads))) {
     patches_.labels.assign(grid.size(), 0);
     for (const std::uint32_t id : grid_.idsInMapOrder()) {
       if (directions_[id].squaredNorm() > 0.0F) seedable_.push_back(id);
@@ -90,6 +101,7 @@ class Detector {
   const ErmsmConfig& config_;
   PlaneScorer scorer_;
   double min_score_;
+  int patch_threads_;  // for the passes over an accepted plane's blocks
   std::vector<std::uint32_t> seedable_;  // blocks with a direction vector, in map order; taken ones pruned now and then
   std::size_t seedable_taken_ = 0;       // of which taken
   std::vector<Candidate> candidates_;    // L_c
@@ -180,7 +192,7 @@ bool Detector::accept(std::size_t index) {
   }
   const double kappa = radians(config_.kappa_deg);
   const std::vector<std::uint32_t> strict = scorer_.matching(accepted.plane);
-  if (spreadExceeds(grid_, directions_, strict, accepted.plane, config_.max_direction_spread_deg)) {
+  if (spreadExceeds(grid_, directions_, strict, accepted.plane, config_.max_direction_spread_deg, patch_threads_)) {
     refused_.push_back(accepted.plane);
     drop(index);
     return false;
@@ -188,7 +200,7 @@ bool Detector::accept(std::size_t index) {
   const std::vector<std::uint32_t> matching =
       withEdges(grid_, directions_, scorer_, strict, accepted.plane, config_.epsilon, kappa);
   auto split = splitIntoPatches(grid_, matching, accepted.plane.normal.cast<double>(),
-                                accepted.plane.point.cast<double>());
+                                accepted.plane.point.cast<double>(), 2, patch_threads_);
   const double cell_area = grid_.cellSize() * grid_.cellSize();
   joinUnseenGaps(grid_, split, accepted.plane.normal.cast<double>(), accepted.plane.point.cast<double>(),
                  config_.epsilon, std::max<std::size_t>(config_.min_patch_blocks, 1), config_.min_patch_area / cell_area);
@@ -199,7 +211,7 @@ bool Detector::accept(std::size_t index) {
   for (const Patch& patch : split) {
     if (patch.surface * cell_area < config_.min_patch_area ||
         patch.blocks.size() < static_cast<std::size_t>(config_.min_patch_blocks) ||
-        isThin(grid_, patch, accepted.plane, min_width)) {
+        isThin(grid_, patch, accepted.plane, min_width, patch_threads_)) {
       continue;
     }
     if (taken.empty()) ++accepted_;

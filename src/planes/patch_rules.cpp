@@ -9,6 +9,13 @@
 #include "pca_sums.hpp"
 
 namespace mlmap {
+namespace {
+
+// Sums over a plane's blocks run in chunks of this many: on several threads for a
+// floor's 150 000, and chunk by chunk in order whatever the thread count.
+constexpr std::size_t kChunk = 8192;
+
+}  // namespace
 
 std::vector<std::uint32_t> withEdges(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                      const PlaneScorer& scorer, std::vector<std::uint32_t> matching,
@@ -60,38 +67,66 @@ double directionSpread(const BlockGrid& grid, const std::vector<Eigen::Vector3f>
 }
 
 bool spreadExceeds(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
-                   const std::vector<std::uint32_t>& ids, const CandidatePlane& plane, double max_deg) {
+                   const std::vector<std::uint32_t>& ids, const CandidatePlane& plane, double max_deg, int threads) {
   // An angle θ = acos c of [0, π/2] lies between sin θ and tan θ: with s = √(1 − c²),
   // s ≤ θ ≤ s / c, bounds 1 / c apart (a part in 6 000 at 1°, 1 % at 8°), where the
-  // blocks of a plane mostly lie within a few degrees of its normal. The weights and
-  // the order of the sums are directionSpread's, so its value lies between the two
-  // bounds' up to rounding (parts in 10¹⁰ for a million blocks), far inside the margin.
+  // blocks of a plane mostly lie within a few degrees of its normal. The weights are
+  // directionSpread's, so its value lies between the two bounds' up to rounding (parts
+  // in 10¹⁰ for a million blocks), far inside the margin.
   constexpr double kMargin = 1e-7;
-  double lower = 0.0;
-  double upper = 0.0;
-  double weight = 0.0;
-  for (const std::uint32_t id : ids) {
-    const double cosine = std::min(1.0F, std::abs(directions[id].dot(plane.normal)));
-    const double sine = std::sqrt(std::max(0.0, 1.0 - cosine * cosine));
-    const double surface = grid.blocks()[id].surface;
-    lower += surface * sine;
-    upper += surface * (sine / cosine);
-    weight += surface;
+  struct Bounds {
+    double lower = 0.0;
+    double upper = 0.0;
+    double weight = 0.0;
+  };
+  // Summed chunk by chunk, the chunks in order: the same sums at any thread count.
+  const std::size_t chunks = (ids.size() + kChunk - 1) / kChunk;
+  std::vector<Bounds> partial(chunks);
+  const auto chunk_count = static_cast<std::int64_t>(chunks);
+#pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (threads > 1 && chunks > 1)
+  for (std::int64_t chunk = 0; chunk < chunk_count; ++chunk) {
+    Bounds& bounds = partial[static_cast<std::size_t>(chunk)];
+    const std::size_t end = std::min(ids.size(), static_cast<std::size_t>(chunk + 1) * kChunk);
+    for (std::size_t n = static_cast<std::size_t>(chunk) * kChunk; n < end; ++n) {
+      const std::uint32_t id = ids[n];
+      const double cosine = std::min(1.0F, std::abs(directions[id].dot(plane.normal)));
+      const double sine = std::sqrt(std::max(0.0, 1.0 - cosine * cosine));
+      const double surface = grid.blocks()[id].surface;
+      bounds.lower += surface * sine;
+      bounds.upper += surface * (sine / cosine);
+      bounds.weight += surface;
+    }
   }
-  if (!(weight > 0.0)) return directionSpread(grid, directions, ids, plane) > max_deg;
+  Bounds total;
+  for (const Bounds& bounds : partial) {
+    total.lower += bounds.lower;
+    total.upper += bounds.upper;
+    total.weight += bounds.weight;
+  }
+  if (!(total.weight > 0.0)) return directionSpread(grid, directions, ids, plane) > max_deg;
   const double degrees = 180.0 / std::numbers::pi;
-  if (lower / weight * degrees > max_deg * (1.0 + kMargin)) return true;
-  if (upper / weight * degrees < max_deg * (1.0 - kMargin)) return false;
+  if (total.lower / total.weight * degrees > max_deg * (1.0 + kMargin)) return true;
+  if (total.upper / total.weight * degrees < max_deg * (1.0 - kMargin)) return false;
   return directionSpread(grid, directions, ids, plane) > max_deg;
 }
 
-bool isThin(const BlockGrid& grid, const Patch& patch, const CandidatePlane& plane, double min_width) {
-  PcaSums pca;
-  for (const std::uint32_t id : patch.blocks) {
-    const PlaneBlock& block = grid.blocks()[id];
-    pca.addBlock((block.point - plane.point).cast<double>(), block.vertical ? 0.5 * (block.top - block.bottom) : 0.0,
-                 1.0);
+bool isThin(const BlockGrid& grid, const Patch& patch, const CandidatePlane& plane, double min_width, int threads) {
+  // Summed chunk by chunk, the chunks in order: the same sums at any thread count.
+  const std::size_t chunks = (patch.blocks.size() + kChunk - 1) / kChunk;
+  std::vector<PcaSums> partial(chunks);
+  const auto chunk_count = static_cast<std::int64_t>(chunks);
+#pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (threads > 1 && chunks > 1)
+  for (std::int64_t chunk = 0; chunk < chunk_count; ++chunk) {
+    PcaSums& pca = partial[static_cast<std::size_t>(chunk)];
+    const std::size_t end = std::min(patch.blocks.size(), static_cast<std::size_t>(chunk + 1) * kChunk);
+    for (std::size_t n = static_cast<std::size_t>(chunk) * kChunk; n < end; ++n) {
+      const PlaneBlock& block = grid.blocks()[patch.blocks[n]];
+      pca.addBlock((block.point - plane.point).cast<double>(), block.vertical ? 0.5 * (block.top - block.bottom) : 0.0,
+                   1.0);
+    }
   }
+  PcaSums pca;
+  for (const PcaSums& sums : partial) pca.addShifted(sums, Eigen::Vector3d::Zero());
   // The spread across the plane: the covariance in the plane's own basis.
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;

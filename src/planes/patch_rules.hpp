@@ -29,12 +29,15 @@ double directionSpread(const BlockGrid& grid, const std::vector<Eigen::Vector3f>
 // Whether directionSpread(...) > max_deg, decided from cheap bounds of each angle where
 // they settle it (nearly always: the ceiling's 150 000 angles cost an arc cosine each),
 // else from directionSpread itself: the same answer either way.
+// `threads`: OpenMP threads for large planes; the answer does not depend on them.
 bool spreadExceeds(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
-                   const std::vector<std::uint32_t>& ids, const CandidatePlane& plane, double max_deg);
+                   const std::vector<std::uint32_t>& ids, const CandidatePlane& plane, double max_deg,
+                   int threads = 1);
 
 // A patch one cell wide is no surface: it is the fringe of a wall standing on a cell
 // boundary (stray points in the next column) or a line of clutter. True when its blocks
 // spread across the plane less than `min_width` (m, standard deviation) in some direction.
-bool isThin(const BlockGrid& grid, const Patch& patch, const CandidatePlane& plane, double min_width);
+bool isThin(const BlockGrid& grid, const Patch& patch, const CandidatePlane& plane, double min_width,
+            int threads = 1);
 
 }  // namespace mlmap

@@ -10,6 +10,9 @@
 namespace mlmap {
 namespace {
 
+// Planes of fewer blocks are rasterised on one thread.
+constexpr std::size_t kParallelBlocks = 20000;
+
 class DisjointSets {
  public:
   explicit DisjointSets(std::size_t count) : parent_(count) {
@@ -47,7 +50,7 @@ struct Footprints {
   std::vector<std::size_t> first_of_block;
 
   Footprints(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& u_axis,
-             const Eigen::Vector3d& v_axis, const Eigen::Vector3d& point) {
+             const Eigen::Vector3d& v_axis, const Eigen::Vector3d& point, int threads = 1) {
     const double cell = grid.cellSize();
     auto cellOf = [&](const Eigen::Vector3d& p) {
       const Eigen::Vector3d relative = p - point;
@@ -56,29 +59,45 @@ struct Footprints {
     };
     // planeBasis makes u = z × n: level exactly, so a vertical block keeps one u.
     const bool level_u = u_axis.z() == 0.0;
-    segments.reserve(blocks.size());
+    auto steps = [&](const PlaneBlock& block) {
+      return std::max(1, static_cast<int>(std::ceil((block.top - block.bottom) / cell)));
+    };
+    // Each block's segments in their own slots, so a floor's are placed on all threads.
+    const auto count = static_cast<std::int64_t>(blocks.size());
+    const bool parallel = threads > 1 && blocks.size() >= kParallelBlocks;
     first_of_block.resize(blocks.size() + 1);
-    for (std::size_t k = 0; k < blocks.size(); ++k) {
-      first_of_block[k] = segments.size();
-      const PlaneBlock& block = grid.blocks()[blocks[k]];
+#pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (parallel)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const PlaneBlock& block = grid.blocks()[blocks[static_cast<std::size_t>(k)]];
+      first_of_block[static_cast<std::size_t>(k) + 1] =
+          !block.vertical ? 1 : level_u ? 2 : 2 + static_cast<std::size_t>(steps(block));
+    }
+    first_of_block[0] = 0;
+    for (std::size_t k = 1; k <= blocks.size(); ++k) first_of_block[k] += first_of_block[k - 1];
+    segments.resize(first_of_block[blocks.size()]);
+#pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (parallel)
+    for (std::int64_t k = 0; k < count; ++k) {
+      Segment* out = segments.data() + first_of_block[static_cast<std::size_t>(k)];
+      const PlaneBlock& block = grid.blocks()[blocks[static_cast<std::size_t>(k)]];
       const Eigen::Vector3d centre = block.point.cast<double>();
       const Eigen::Vector2i centre_cell = cellOf(centre);
-      segments.push_back({centre_cell.x(), centre_cell.y(), centre_cell.y()});
+      *out++ = {centre_cell.x(), centre_cell.y(), centre_cell.y()};
       if (!block.vertical) continue;
       const double depth = block.top - block.bottom;
-      const int steps = std::max(1, static_cast<int>(std::ceil(depth / cell)));
-      auto sample = [&](int s) { return cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.bottom + depth * s / steps)); };
+      const int step_count = steps(block);
+      auto sample = [&](int s) {
+        return cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.bottom + depth * s / step_count));
+      };
       if (level_u) {
         // v grows with height (v_z ≥ 0) by at most a cell per step: one run.
-        segments.push_back({centre_cell.x(), sample(0).y(), sample(steps).y()});
+        *out = {centre_cell.x(), sample(0).y(), sample(step_count).y()};
       } else {
-        for (int s = 0; s <= steps; ++s) {
+        for (int s = 0; s <= step_count; ++s) {
           const Eigen::Vector2i c = sample(s);
-          segments.push_back({c.x(), c.y(), c.y()});
+          *out++ = {c.x(), c.y(), c.y()};
         }
       }
     }
-    first_of_block[blocks.size()] = segments.size();
   }
 };
 
@@ -286,12 +305,12 @@ void planeBasis(const Eigen::Vector3d& normal, Eigen::Vector3d& u, Eigen::Vector
 
 std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
                                     const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
-                                    int gap_cells) {
+                                    int gap_cells, int threads) {
   if (blocks.empty()) return {};
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;
   planeBasis(normal, u_axis, v_axis);
-  const Footprints footprints(grid, blocks, u_axis, v_axis, point);
+  const Footprints footprints(grid, blocks, u_axis, v_axis, point, threads);
   const std::vector<Segment>& segments = footprints.segments;
   // Cells are connected within gap_cells (Chebyshev). Not cell by cell (a wall at 2 cm
   // rasterises to over half a million cells): in each raster column u, segments less

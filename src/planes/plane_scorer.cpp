@@ -25,6 +25,8 @@ constexpr int kTileCells = 16;
 constexpr float kCosMargin = 1e-5F;
 // Maps of fewer blocks build their index on one thread.
 constexpr std::size_t kParallelBlocks = 100000;
+// ... and refresh fewer tiles than this on one thread.
+constexpr std::int64_t kParallelTiles = 64;
 
 // Azimuth columns per elevation row, so that bins cover similar solid angles; and the
 // first bin of every row.
@@ -111,10 +113,11 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
 #ifdef _OPENMP
   // Small maps build their index on one thread: there a parallel region saves little,
   // and on a shared machine it can wait milliseconds for a core.
-  const int team = grid.size() < kParallelBlocks ? 1 : threads > 0 ? threads : omp_get_max_threads();
+  team_ = grid.size() < kParallelBlocks ? 1 : threads > 0 ? threads : omp_get_max_threads();
 #else
-  const int team = std::max(1, threads);  // the pragmas are ignored
+  team_ = std::max(1, threads);  // the pragmas are ignored
 #endif
+  const int team = team_;
 #pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
   for (std::int64_t id = 0; id < count; ++id) {
     const Eigen::Vector3f& d = directions[static_cast<std::size_t>(id)];
@@ -164,11 +167,35 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
                                           static_cast<std::int32_t>(std::floor(frame.v.dot(p) / tile_size)), id};
   }
   // Ordered by (bin, layer, tile), ids ascending within a tile: stable sorts from the
-  // least significant key (a comparison sort of the 5-tuples cost far more).
-  stableSortBy(order, [](const Place& place) { return place.tile_v; });
-  stableSortBy(order, [](const Place& place) { return place.tile_u; });
-  stableSortBy(order, [](const Place& place) { return place.layer; });
-  stableSortBy(order, [](const Place& place) { return place.bin; });
+  // least significant key (a comparison sort of the 5-tuples cost far more), two of
+  // them: by the tile's number in the box of all tiles, then by the layer's number
+  // among all bins' layers (each bin's layers follow the previous bin's).
+  std::int32_t low_u = 0, high_u = 0, low_v = 0, high_v = 0;
+  std::vector<std::int32_t> low_layer(bins, std::numeric_limits<std::int32_t>::max());
+  std::vector<std::int32_t> high_layer(bins, std::numeric_limits<std::int32_t>::min());
+  for (std::size_t n = 0; n < order.size(); ++n) {
+    const Place& place = order[n];
+    low_u = n == 0 ? place.tile_u : std::min(low_u, place.tile_u);
+    high_u = n == 0 ? place.tile_u : std::max(high_u, place.tile_u);
+    low_v = n == 0 ? place.tile_v : std::min(low_v, place.tile_v);
+    high_v = n == 0 ? place.tile_v : std::max(high_v, place.tile_v);
+    const auto bin = static_cast<std::size_t>(place.bin);
+    low_layer[bin] = std::min(low_layer[bin], place.layer);
+    high_layer[bin] = std::max(high_layer[bin], place.layer);
+  }
+  const std::int64_t tile_rows = static_cast<std::int64_t>(high_v) - low_v + 1;
+  std::vector<std::int64_t> first_layer(bins + 1, 0);
+  for (std::size_t b = 0; b < bins; ++b) {
+    const bool used = low_layer[b] <= high_layer[b];
+    first_layer[b + 1] = first_layer[b] + (used ? static_cast<std::int64_t>(high_layer[b]) - low_layer[b] + 1 : 0);
+  }
+  stableSortBy(order, [&](const Place& place) {
+    return (static_cast<std::int64_t>(place.tile_u) - low_u) * tile_rows + (static_cast<std::int64_t>(place.tile_v) - low_v);
+  });
+  stableSortBy(order, [&](const Place& place) {
+    const auto bin = static_cast<std::size_t>(place.bin);
+    return first_layer[bin] + (static_cast<std::int64_t>(place.layer) - low_layer[bin]);
+  });
   bins_.resize(bins);
   std::size_t layer_count = 0;
   std::size_t tile_count = 0;
@@ -300,7 +327,10 @@ void PlaneScorer::sumTile(Node& tile) const {
 
 // Recomputes the sums of the given tiles (ascending) and of their layers and bins.
 void PlaneScorer::refresh(const std::vector<std::uint32_t>& tiles) {
-  for (const std::uint32_t t : tiles) sumTile(tiles_[t]);
+  // Each tile on its own: a floor's take refreshes a thousand tiles of 150 blocks.
+  const auto count = static_cast<std::int64_t>(tiles.size());
+#pragma omp parallel for schedule(dynamic, 16) num_threads(team_) if (team_ > 1 && count > kParallelTiles)
+  for (std::int64_t n = 0; n < count; ++n) sumTile(tiles_[tiles[static_cast<std::size_t>(n)]]);
   sumLayersAndBins(tiles);
 }
 

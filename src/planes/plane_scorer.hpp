@@ -83,6 +83,7 @@ class PlaneScorer {
   const std::vector<Eigen::Vector3f>& directions_;
   float epsilon_;
   float cos_kappa_;
+  int team_ = 1;  // OpenMP threads for building and refreshing the index
   std::vector<Node> bins_;    // children: layers
   std::vector<Frame> frames_; // per bin
   std::vector<Node> layers_;  // children: tiles

@@ -24,9 +24,10 @@ void planeBasis(const Eigen::Vector3d& normal, Eigen::Vector3d& u, Eigen::Vector
 // Blocks are rasterised on a grid of cell_size in the plane (a vertical block over
 // its whole height); occupied grid cells within `gap_cells` (Chebyshev) of each other
 // are connected. Patches are returned largest first, without outlines (outlineOf).
+// `threads`: OpenMP threads for large planes; the patches do not depend on them.
 std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
                                     const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
-                                    int gap_cells = 2);
+                                    int gap_cells = 2, int threads = 1);
 
 // The outline of the blocks on the plane through `point`: the boundary loop of their
 // raster cells enclosing the most area, counter-clockwise about the normal, corners only.
