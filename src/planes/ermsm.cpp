@@ -387,16 +387,22 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));  // the merged levels'
   stats.stages.merges += stage();
   detection.planes = std::move(patches.planes);
-  for (std::size_t n = 0; n < grid.cellCount(); ++n) {
-    const auto blocks = map.mutableBlocksAt(grid.mapCellOf(n));
-    for (std::uint32_t id = grid.firstBlockOfCell(n); id < grid.firstBlockOfCell(n + 1); ++id) {
+  // Each cell's blocks on their own: on all threads.
+  const auto cells = static_cast<std::int64_t>(grid.cellCount());
+  std::size_t labelled = 0;
+#pragma omp parallel for schedule(static) num_threads(teamSize(patchPassThreads(grid, config.threads))) reduction(+ : labelled)
+  for (std::int64_t n = 0; n < cells; ++n) {
+    const auto cell = static_cast<std::size_t>(n);
+    const auto blocks = map.mutableBlocksAt(grid.mapCellOf(cell));
+    for (std::uint32_t id = grid.firstBlockOfCell(cell); id < grid.firstBlockOfCell(cell + 1); ++id) {
       const PlaneBlock& block = grid.blocks()[id];
       for (std::size_t k = block.map_first; k < block.map_first + block.map_count; ++k) {
         blocks[k].plane = patches.labels[id];
-        if (blocks[k].plane != 0) ++stats.labelled_blocks;
+        if (blocks[k].plane != 0) ++labelled;
       }
     }
   }
+  stats.labelled_blocks = labelled;
   stats.stages.labels = stage();
   // Everything after the direction vectors, the labels written back included.
   stats.detection_seconds = secondsSince(detection_start);
