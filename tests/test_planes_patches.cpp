@@ -11,6 +11,7 @@
 #include <set>
 
 #include "../src/planes/counting_sort.hpp"
+#include "../src/planes/outline_runs.hpp"
 #include "../src/planes/patch_rules.hpp"
 #include "../src/planes/plane_scorer.hpp"
 #include "mlmap/planes/block_grid.hpp"
@@ -221,6 +222,41 @@ TEST_CASE("splitIntoPatches: components over raster column runs equal cell-by-ce
     }
   }
   CHECK(most_patches > 3);
+}
+
+TEST_CASE("splitWithOutlineRuns: each patch's runs trace the outline outlineOf traces from its blocks, at gaps 1 and 2") {
+  test::PlaneSceneBuilder scene = patchScene();
+  const BlockGrid grid(scene.map());
+  std::vector<std::uint32_t> all(grid.size());
+  std::iota(all.begin(), all.end(), std::uint32_t{0});
+  std::mt19937 random(9);
+  const std::vector<Eigen::Vector3d> normals{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(),
+                                            Eigen::Vector3d(std::sin(0.17), 0.0, std::cos(0.17))};
+  std::size_t compared = 0;
+  for (const Eigen::Vector3d& normal : normals) {
+    for (const bool sparse : {false, true}) {
+      std::vector<std::uint32_t> blocks;
+      for (const std::uint32_t id : all) {
+        if (!sparse || random() % 4 == 0) blocks.push_back(id);
+      }
+      for (const int gap : {1, 2}) {
+        const Eigen::Vector3d point(0.013, -0.021, 0.007);
+        const SplitPatches split = splitWithOutlineRuns(grid, blocks, normal, point, gap, 2);
+        const std::vector<Patch> plain = splitIntoPatches(grid, blocks, normal, point, gap);
+        REQUIRE(split.patches.size() == plain.size());
+        REQUIRE(split.outline_runs.size() == plain.size());
+        for (std::size_t k = 0; k < plain.size(); ++k) {
+          CHECK(split.patches[k].blocks == plain[k].blocks);
+          const auto expected = outlineOf(grid, plain[k].blocks, normal, point);
+          const auto traced = outlineOfRuns(split.outline_runs[k], grid.cellSize(), normal, point);
+          REQUIRE(traced.size() == expected.size());
+          for (std::size_t c = 0; c < expected.size(); ++c) CHECK(traced[c] == expected[c]);
+          ++compared;
+        }
+      }
+    }
+  }
+  CHECK(compared > 20);
 }
 
 TEST_CASE("outlineOf: the same outline whatever order the blocks are listed in") {

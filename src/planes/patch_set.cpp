@@ -23,6 +23,7 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
   std::vector<Plane> merged;
   std::vector<std::vector<std::uint32_t>> merged_blocks;
   std::vector<OutlineFrame> merged_frames;
+  std::vector<std::vector<Segment>> merged_runs;
   std::vector<std::int32_t> new_id(count, 0);
   for (std::size_t k = 0; k < count; ++k) {
     if (roots[k] != k) continue;
@@ -31,10 +32,12 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
     Plane plane;
     Patch patch;
     OutlineFrame frame;
+    std::vector<Segment> runs;
     if (members == 1) {
       plane = planes[k];  // alone: as it was
       patch.blocks = std::move(set.blocks[k]);
       frame = set.outline_frames[k];
+      runs = std::move(set.outline_runs[k]);
     } else {
       // Each member's blocks are ascending: merged, not sorted again.
       for (std::size_t member = 0; member < count; ++member) {
@@ -59,10 +62,12 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
     merged.push_back(std::move(plane));
     merged_blocks.push_back(std::move(patch.blocks));
     merged_frames.push_back(frame);
+    merged_runs.push_back(std::move(runs));
   }
   set.planes = std::move(merged);
   set.blocks = std::move(merged_blocks);
   set.outline_frames = std::move(merged_frames);
+  set.outline_runs = std::move(merged_runs);
   for (std::int32_t& label : set.labels) {
     if (label > 0) label = new_id[static_cast<std::size_t>(label - 1)];
   }
@@ -140,8 +145,11 @@ void tracePendingOutlines(const BlockGrid& grid, PatchSet& set, int threads) {
   for (std::int64_t n = 0; n < count; ++n) {
     const std::size_t k = pending[static_cast<std::size_t>(n)];
     OutlineFrame& frame = set.outline_frames[k];
-    placeOutline(set.planes[k], outlineOf(grid, set.blocks[k], frame.normal, frame.point));
+    std::vector<Segment>& runs = set.outline_runs[k];
+    placeOutline(set.planes[k], runs.empty() ? outlineOf(grid, set.blocks[k], frame.normal, frame.point)
+                                             : outlineOfRuns(runs, grid.cellSize(), frame.normal, frame.point));
     frame.pending = false;
+    runs = {};
   }
 }
 

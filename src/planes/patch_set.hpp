@@ -9,6 +9,7 @@
 #include "mlmap/planes/block_grid.hpp"
 #include "mlmap/planes/patches.hpp"
 #include "mlmap/planes/plane.hpp"
+#include "outline_runs.hpp"
 #include "plane_scorer.hpp"
 
 namespace mlmap {
@@ -26,6 +27,9 @@ struct PatchSet {
   std::vector<Plane> planes;                       // ids 1..n in order
   std::vector<std::vector<std::uint32_t>> blocks;  // block ids of each plane, ascending
   std::vector<OutlineFrame> outline_frames;        // per plane
+  // Per plane, its raster runs on its outline frame when the split left them (empty:
+  // rasterised from its blocks).
+  std::vector<std::vector<Segment>> outline_runs;
   std::vector<std::int32_t> labels;                // per block id: its plane's id, 0 for none
 };
 

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "counting_sort.hpp"
+#include "outline_runs.hpp"
 
 namespace mlmap {
 namespace {
@@ -30,13 +31,6 @@ class DisjointSets {
 
  private:
   std::vector<std::size_t> parent_;
-};
-
-// A block's footprint on the plane's raster: raster cells (u, v) with v in [v_low, v_high].
-struct Segment {
-  std::int32_t u;
-  std::int32_t v_low;
-  std::int32_t v_high;
 };
 
 // The footprints of the blocks on a raster of cell_size along the plane basis from
@@ -103,12 +97,15 @@ struct Footprints {
 
 // The footprints merged per raster column: segments of a column whose rows are at most
 // `join_gap` apart join into one run (1: touching or overlapping ones). Runs are ordered
-// by u, then v, and disjoint; run_of_segment names each segment's run.
+// by u, then v, and disjoint; run_of_segment names each segment's run. With a
+// `fine_gap` under join_gap, also the runs at that gap, each inside one run (its parent).
 struct ColumnRuns {
   std::vector<Segment> runs;
   std::vector<std::uint32_t> run_of_segment;
+  std::vector<Segment> fine_runs;
+  std::vector<std::uint32_t> parent_of_fine_run;
 
-  ColumnRuns(const std::vector<Segment>& segments, int join_gap) : run_of_segment(segments.size()) {
+  ColumnRuns(const std::vector<Segment>& segments, int join_gap, int fine_gap = 0) : run_of_segment(segments.size()) {
     struct Numbered {
       Segment segment;
       std::uint32_t number;
@@ -125,6 +122,15 @@ struct ColumnRuns {
         runs.back().v_high = std::max(runs.back().v_high, segment.v_high);
       }
       run_of_segment[n] = static_cast<std::uint32_t>(runs.size() - 1);
+      if (fine_gap <= 0) continue;
+      // A new run starts a new fine run too (its gap is wider than the fine one).
+      if (fine_runs.empty() || fine_runs.back().u != segment.u ||
+          static_cast<std::int64_t>(segment.v_low) - fine_runs.back().v_high > fine_gap) {
+        fine_runs.push_back(segment);
+        parent_of_fine_run.push_back(static_cast<std::uint32_t>(runs.size() - 1));
+      } else {
+        fine_runs.back().v_high = std::max(fine_runs.back().v_high, segment.v_high);
+      }
     }
   }
 };
@@ -303,10 +309,11 @@ void planeBasis(const Eigen::Vector3d& normal, Eigen::Vector3d& u, Eigen::Vector
   v = normal.cross(u).normalized();
 }
 
-std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
-                                    const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
-                                    int gap_cells, int threads) {
-  if (blocks.empty()) return {};
+SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
+                                  const Eigen::Vector3d& normal, const Eigen::Vector3d& point, int gap_cells,
+                                  int threads) {
+  SplitPatches split;
+  if (blocks.empty()) return split;
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;
   planeBasis(normal, u_axis, v_axis);
@@ -317,8 +324,9 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
   // than gap_cells apart join into runs, and runs of columns up to gap_cells apart
   // connect when their closest cells are: when neither starts more than gap_cells past
   // the other's end. (Both runs' ends are occupied, and no cell inside a run is more
-  // than gap_cells / 2 from an occupied one.)
-  const ColumnRuns column_runs(segments, gap_cells);
+  // than gap_cells / 2 from an occupied one.) The touching runs the outlines are traced
+  // on come out of the same pass.
+  const ColumnRuns column_runs(segments, gap_cells, gap_cells > 1 ? 1 : 0);
   const std::vector<Segment>& runs = column_runs.runs;
   const std::vector<std::uint32_t>& run_of_segment = column_runs.run_of_segment;
   // The runs of each column: [column_first[u − min_u], column_first[u − min_u + 1]).
@@ -356,24 +364,58 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
     patch.blocks.push_back(blocks[k]);
     patch.surface += grid.blocks()[blocks[k]].surface;
   }
-  std::stable_sort(patches.begin(), patches.end(),
-                   [](const Patch& a, const Patch& b) { return a.surface > b.surface; });
-  return patches;
+  // Each patch's touching runs (at a gap of one cell the runs themselves; at none, the
+  // outline's runs are not known here and stay empty).
+  std::vector<std::vector<Segment>> outline_runs(patches.size());
+  if (gap_cells > 1) {
+    for (std::size_t f = 0; f < column_runs.fine_runs.size(); ++f) {
+      const auto patch = static_cast<std::size_t>(patch_of_root[sets.find(column_runs.parent_of_fine_run[f])]);
+      outline_runs[patch].push_back(column_runs.fine_runs[f]);
+    }
+  } else if (gap_cells == 1) {
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      outline_runs[static_cast<std::size_t>(patch_of_root[sets.find(r)])].push_back(runs[r]);
+    }
+  }
+  std::vector<std::size_t> largest_first(patches.size());
+  std::iota(largest_first.begin(), largest_first.end(), std::size_t{0});
+  std::stable_sort(largest_first.begin(), largest_first.end(),
+                   [&](std::size_t a, std::size_t b) { return patches[a].surface > patches[b].surface; });
+  for (const std::size_t k : largest_first) {
+    split.patches.push_back(std::move(patches[k]));
+    split.outline_runs.push_back(std::move(outline_runs[k]));
+  }
+  return split;
+}
+
+std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
+                                    const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
+                                    int gap_cells, int threads) {
+  return splitWithOutlineRuns(grid, blocks, normal, point, gap_cells, threads).patches;
+}
+
+std::vector<Eigen::Vector3d> outlineOfRuns(const std::vector<Segment>& runs, double cell_size,
+                                           const Eigen::Vector3d& normal, const Eigen::Vector3d& point) {
+  std::vector<Eigen::Vector3d> outline;
+  if (runs.empty()) return outline;
+  Eigen::Vector3d u_axis;
+  Eigen::Vector3d v_axis;
+  planeBasis(normal, u_axis, v_axis);
+  PlaneRaster raster(runs, 1);
+  for (const Eigen::Vector2i& corner : outerBoundary(raster, [](std::size_t) { return true; })) {
+    outline.push_back(point + u_axis * (corner.x() * cell_size) + v_axis * (corner.y() * cell_size));
+  }
+  return outline;
 }
 
 std::vector<Eigen::Vector3d> outlineOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
                                        const Eigen::Vector3d& normal, const Eigen::Vector3d& point) {
-  std::vector<Eigen::Vector3d> outline;
-  if (blocks.empty()) return outline;
+  if (blocks.empty()) return {};
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;
   planeBasis(normal, u_axis, v_axis);
-  PlaneRaster raster(ColumnRuns(Footprints(grid, blocks, u_axis, v_axis, point).segments, 1).runs, 1);
-  const double cell = grid.cellSize();
-  for (const Eigen::Vector2i& corner : outerBoundary(raster, [](std::size_t) { return true; })) {
-    outline.push_back(point + u_axis * (corner.x() * cell) + v_axis * (corner.y() * cell));
-  }
-  return outline;
+  return outlineOfRuns(ColumnRuns(Footprints(grid, blocks, u_axis, v_axis, point).segments, 1).runs, grid.cellSize(),
+                       normal, point);
 }
 
 }  // namespace mlmap
