@@ -280,17 +280,26 @@ TEST_CASE("outlineOf: the same outline whatever order the blocks are listed in")
   }
 }
 
-TEST_CASE("stableSortBy: a counting sort, or a stable sort for wide key ranges, equals std::stable_sort") {
+TEST_CASE("stableSortBy: a counting sort, or a stable sort for wide key ranges, equals std::stable_sort, on 1 to 3 threads") {
   std::mt19937 random(11);
-  for (const std::int64_t range : {std::int64_t{5}, std::int64_t{1000}, std::int64_t{1} << 40}) {
-    std::vector<std::pair<std::int64_t, std::uint32_t>> items(3000);
-    for (std::uint32_t k = 0; k < items.size(); ++k) {
-      items[k] = {static_cast<std::int64_t>(random() % static_cast<std::uint64_t>(range)) - range / 2, k};
+  // Short lists are sorted on one thread whatever is asked; long ones in slices.
+  for (const std::size_t size : {std::size_t{3000}, std::size_t{120000}}) {
+    for (const std::int64_t range : {std::int64_t{5}, std::int64_t{1000}, std::int64_t{1} << 40}) {
+      std::vector<std::pair<std::int64_t, std::uint32_t>> items(size);
+      for (std::uint32_t k = 0; k < items.size(); ++k) {
+        items[k] = {static_cast<std::int64_t>(random() % static_cast<std::uint64_t>(range)) - range / 2, k};
+      }
+      auto expected = items;
+      std::stable_sort(expected.begin(), expected.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      for (const int threads : {1, 2, 3}) {
+        CAPTURE(size);
+        CAPTURE(range);
+        CAPTURE(threads);
+        auto sorted = items;
+        stableSortBy(sorted, [](const auto& item) { return item.first; }, threads);
+        CHECK(sorted == expected);
+      }
     }
-    auto expected = items;
-    std::stable_sort(expected.begin(), expected.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    stableSortBy(items, [](const auto& item) { return item.first; });
-    CHECK(items == expected);
   }
 }
 

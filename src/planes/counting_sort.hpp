@@ -12,25 +12,56 @@ namespace mlmap {
 // kilometres long). Sorting by the least significant key first and the most significant
 // last orders by all of them. The items move, not indices to them: each pass then reads
 // them in order, where looking keys up through indices jumps across memory.
+//
+// With `threads` > 1 a long list is counted and placed in as many contiguous slices at
+// once: a key's items from an earlier slice go first, so the order is the same.
 template <typename Item, typename Key>
-void stableSortBy(std::vector<Item>& items, Key key) {
+void stableSortBy(std::vector<Item>& items, Key key, int threads = 1) {
   if (items.empty()) return;
+  constexpr std::size_t kParallelItems = 50000;
+  const auto count = static_cast<std::int64_t>(items.size());
+  const int slices = threads > 1 && items.size() >= kParallelItems ? threads : 1;
   std::int64_t low = key(items[0]);
   std::int64_t high = low;
-  for (const Item& item : items) {
-    low = std::min<std::int64_t>(low, key(item));
-    high = std::max<std::int64_t>(high, key(item));
+#pragma omp parallel for schedule(static) num_threads(slices) if (slices > 1) reduction(min : low) reduction(max : high)
+  for (std::int64_t n = 0; n < count; ++n) {
+    const std::int64_t k = key(items[static_cast<std::size_t>(n)]);
+    low = std::min(low, k);
+    high = std::max(high, k);
   }
   const auto range = static_cast<std::size_t>(high - low + 1);
   if (range > 4 * items.size() + 4096) {
     std::stable_sort(items.begin(), items.end(), [&](const Item& a, const Item& b) { return key(a) < key(b); });
     return;
   }
-  std::vector<std::uint32_t> first(range + 1, 0);
-  for (const Item& item : items) ++first[static_cast<std::size_t>(key(item) - low) + 1];
-  for (std::size_t k = 1; k <= range; ++k) first[k] += first[k - 1];
+  // next[slice × range + key]: where the slice's next item of that key goes.
+  std::vector<std::uint32_t> next(static_cast<std::size_t>(slices) * range, 0);
+  auto sliceBegin = [&](int slice) { return count * slice / slices; };
+#pragma omp parallel for schedule(static, 1) num_threads(slices) if (slices > 1)
+  for (int slice = 0; slice < slices; ++slice) {
+    std::uint32_t* counts = next.data() + static_cast<std::size_t>(slice) * range;
+    for (std::int64_t n = sliceBegin(slice); n < sliceBegin(slice + 1); ++n) {
+      ++counts[static_cast<std::size_t>(key(items[static_cast<std::size_t>(n)]) - low)];
+    }
+  }
+  std::uint32_t placed = 0;
+  for (std::size_t k = 0; k < range; ++k) {
+    for (int slice = 0; slice < slices; ++slice) {
+      std::uint32_t& slot = next[static_cast<std::size_t>(slice) * range + k];
+      const std::uint32_t members = slot;
+      slot = placed;
+      placed += members;
+    }
+  }
   std::vector<Item> sorted(items.size());
-  for (const Item& item : items) sorted[first[static_cast<std::size_t>(key(item) - low)]++] = item;
+#pragma omp parallel for schedule(static, 1) num_threads(slices) if (slices > 1)
+  for (int slice = 0; slice < slices; ++slice) {
+    std::uint32_t* positions = next.data() + static_cast<std::size_t>(slice) * range;
+    for (std::int64_t n = sliceBegin(slice); n < sliceBegin(slice + 1); ++n) {
+      const Item& item = items[static_cast<std::size_t>(n)];
+      sorted[positions[static_cast<std::size_t>(key(item) - low)]++] = item;
+    }
+  }
   items = std::move(sorted);
 }
 

@@ -105,15 +105,16 @@ struct ColumnRuns {
   std::vector<Segment> fine_runs;
   std::vector<std::uint32_t> parent_of_fine_run;
 
-  ColumnRuns(const std::vector<Segment>& segments, int join_gap, int fine_gap = 0) : run_of_segment(segments.size()) {
+  ColumnRuns(const std::vector<Segment>& segments, int join_gap, int fine_gap = 0, int threads = 1)
+      : run_of_segment(segments.size()) {
     struct Numbered {
       Segment segment;
       std::uint32_t number;
     };
     std::vector<Numbered> order(segments.size());
     for (std::uint32_t n = 0; n < segments.size(); ++n) order[n] = {segments[n], n};
-    stableSortBy(order, [](const Numbered& item) { return item.segment.v_low; });
-    stableSortBy(order, [](const Numbered& item) { return item.segment.u; });
+    stableSortBy(order, [](const Numbered& item) { return item.segment.v_low; }, threads);
+    stableSortBy(order, [](const Numbered& item) { return item.segment.u; }, threads);
     for (const auto& [segment, n] : order) {
       if (runs.empty() || runs.back().u != segment.u ||
           static_cast<std::int64_t>(segment.v_low) - runs.back().v_high > join_gap) {
@@ -326,7 +327,7 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
   // the other's end. (Both runs' ends are occupied, and no cell inside a run is more
   // than gap_cells / 2 from an occupied one.) The touching runs the outlines are traced
   // on come out of the same pass.
-  const ColumnRuns column_runs(segments, gap_cells, gap_cells > 1 ? 1 : 0);
+  const ColumnRuns column_runs(segments, gap_cells, gap_cells > 1 ? 1 : 0, threads);
   const std::vector<Segment>& runs = column_runs.runs;
   const std::vector<std::uint32_t>& run_of_segment = column_runs.run_of_segment;
   // The runs of each column: [column_first[u − min_u], column_first[u − min_u + 1]).

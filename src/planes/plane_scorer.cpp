@@ -189,13 +189,19 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
     const bool used = low_layer[b] <= high_layer[b];
     first_layer[b + 1] = first_layer[b] + (used ? static_cast<std::int64_t>(high_layer[b]) - low_layer[b] + 1 : 0);
   }
-  stableSortBy(order, [&](const Place& place) {
-    return (static_cast<std::int64_t>(place.tile_u) - low_u) * tile_rows + (static_cast<std::int64_t>(place.tile_v) - low_v);
-  });
-  stableSortBy(order, [&](const Place& place) {
-    const auto bin = static_cast<std::size_t>(place.bin);
-    return first_layer[bin] + (static_cast<std::int64_t>(place.layer) - low_layer[bin]);
-  });
+  stableSortBy(
+      order,
+      [&](const Place& place) {
+        return (static_cast<std::int64_t>(place.tile_u) - low_u) * tile_rows + (static_cast<std::int64_t>(place.tile_v) - low_v);
+      },
+      team);
+  stableSortBy(
+      order,
+      [&](const Place& place) {
+        const auto bin = static_cast<std::size_t>(place.bin);
+        return first_layer[bin] + (static_cast<std::int64_t>(place.layer) - low_layer[bin]);
+      },
+      team);
   bins_.resize(bins);
   std::size_t layer_count = 0;
   std::size_t tile_count = 0;
