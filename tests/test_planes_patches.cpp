@@ -193,69 +193,64 @@ TEST_CASE("BlockGrid: blocks numbered row by row, a Chebyshev window's blocks vi
   for (std::uint32_t id = 0; id < grid.size(); ++id) CHECK(in_map_order[id] == id);
 }
 
-TEST_CASE("splitIntoPatches: components over raster column runs equal cell-by-cell components") {
-  test::PlaneSceneBuilder scene = patchScene();
-  const BlockGrid grid(scene.map());
-  std::vector<std::uint32_t> all(grid.size());
-  std::iota(all.begin(), all.end(), std::uint32_t{0});
-  std::mt19937 random(3);
-  // A wall's plane (u level: a vertical block is one run), a floor's, and a plane tilted
-  // 10° (u not level: a vertical block is cells a cell apart); every block, and a sparse
-  // random tenth so that many small components form.
+namespace {
+
+// The planes the split tests cut the patch scene with: a wall's plane (u level: a
+// vertical block is one run), a floor's, and a plane tilted 10° (u not level: a
+// vertical block is cells a cell apart); every block, and a sparse random one in
+// `keep_one_in` so that many small components form; gaps of 1 and 2 cells.
+template <typename Check>
+void forEachSplitCase(const BlockGrid& grid, unsigned seed, unsigned keep_one_in, Check&& check) {
+  std::mt19937 random(seed);
   const std::vector<Eigen::Vector3d> normals{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(),
                                             Eigen::Vector3d(std::sin(0.17), 0.0, std::cos(0.17))};
-  std::size_t most_patches = 0;
   for (const Eigen::Vector3d& normal : normals) {
     for (const bool sparse : {false, true}) {
       std::vector<std::uint32_t> blocks;
-      for (const std::uint32_t id : all) {
-        if (!sparse || random() % 10 == 0) blocks.push_back(id);
+      for (std::uint32_t id = 0; id < grid.size(); ++id) {
+        if (!sparse || random() % keep_one_in == 0) blocks.push_back(id);
       }
-      for (const int gap : {1, 2}) {
-        const Eigen::Vector3d point(0.013, -0.021, 0.007);
-        const std::vector<Patch> patches = splitIntoPatches(grid, blocks, normal, point, gap);
-        const auto expected = referencePatches(grid, blocks, normal, point, gap);
-        REQUIRE(patches.size() == expected.size());
-        for (std::size_t k = 0; k < patches.size(); ++k) CHECK(patches[k].blocks == expected[k]);
-        most_patches = std::max(most_patches, patches.size());
-      }
+      for (const int gap : {1, 2}) check(blocks, normal, Eigen::Vector3d(0.013, -0.021, 0.007), gap);
     }
   }
+}
+
+}  // namespace
+
+TEST_CASE("splitIntoPatches: components over raster column runs equal cell-by-cell components") {
+  test::PlaneSceneBuilder scene = patchScene();
+  const BlockGrid grid(scene.map());
+  std::size_t most_patches = 0;
+  forEachSplitCase(grid, 3, 10, [&](const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
+                                    const Eigen::Vector3d& point, int gap) {
+    const std::vector<Patch> patches = splitIntoPatches(grid, blocks, normal, point, gap);
+    const auto expected = referencePatches(grid, blocks, normal, point, gap);
+    REQUIRE(patches.size() == expected.size());
+    for (std::size_t k = 0; k < patches.size(); ++k) CHECK(patches[k].blocks == expected[k]);
+    most_patches = std::max(most_patches, patches.size());
+  });
   CHECK(most_patches > 3);
 }
 
 TEST_CASE("splitWithOutlineRuns: each patch's runs trace the outline outlineOf traces from its blocks, at gaps 1 and 2") {
   test::PlaneSceneBuilder scene = patchScene();
   const BlockGrid grid(scene.map());
-  std::vector<std::uint32_t> all(grid.size());
-  std::iota(all.begin(), all.end(), std::uint32_t{0});
-  std::mt19937 random(9);
-  const std::vector<Eigen::Vector3d> normals{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(),
-                                            Eigen::Vector3d(std::sin(0.17), 0.0, std::cos(0.17))};
   std::size_t compared = 0;
-  for (const Eigen::Vector3d& normal : normals) {
-    for (const bool sparse : {false, true}) {
-      std::vector<std::uint32_t> blocks;
-      for (const std::uint32_t id : all) {
-        if (!sparse || random() % 4 == 0) blocks.push_back(id);
-      }
-      for (const int gap : {1, 2}) {
-        const Eigen::Vector3d point(0.013, -0.021, 0.007);
-        const SplitPatches split = splitWithOutlineRuns(grid, blocks, normal, point, gap, 2);
-        const std::vector<Patch> plain = splitIntoPatches(grid, blocks, normal, point, gap);
-        REQUIRE(split.patches.size() == plain.size());
-        REQUIRE(split.outline_runs.size() == plain.size());
-        for (std::size_t k = 0; k < plain.size(); ++k) {
-          CHECK(split.patches[k].blocks == plain[k].blocks);
-          const auto expected = outlineOf(grid, plain[k].blocks, normal, point);
-          const auto traced = outlineOfRuns(split.outline_runs[k], grid.cellSize(), normal, point);
-          REQUIRE(traced.size() == expected.size());
-          for (std::size_t c = 0; c < expected.size(); ++c) CHECK(traced[c] == expected[c]);
-          ++compared;
-        }
-      }
+  forEachSplitCase(grid, 9, 4, [&](const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
+                                   const Eigen::Vector3d& point, int gap) {
+    const SplitPatches split = splitWithOutlineRuns(grid, blocks, normal, point, gap, 2);
+    const std::vector<Patch> plain = splitIntoPatches(grid, blocks, normal, point, gap);
+    REQUIRE(split.patches.size() == plain.size());
+    REQUIRE(split.outline_runs.size() == plain.size());
+    for (std::size_t k = 0; k < plain.size(); ++k) {
+      CHECK(split.patches[k].blocks == plain[k].blocks);
+      const auto expected = outlineOf(grid, plain[k].blocks, normal, point);
+      const auto traced = outlineOfRuns(split.outline_runs[k], grid.cellSize(), normal, point);
+      REQUIRE(traced.size() == expected.size());
+      for (std::size_t c = 0; c < expected.size(); ++c) CHECK(traced[c] == expected[c]);
+      ++compared;
     }
-  }
+  });
   CHECK(compared > 20);
 }
 

@@ -201,30 +201,19 @@ bool Detector::accept(std::size_t index) {
       withEdges(grid_, directions_, scorer_, strict, accepted.plane, config_.epsilon, kappa);
   SplitPatches split = splitWithOutlineRuns(grid_, matching, accepted.plane.normal.cast<double>(),
                                             accepted.plane.point.cast<double>(), 2, patch_threads_);
-  // The patches' runs by their first block: a patch the join leaves as it was keeps
-  // them, a joined one is rasterised again for its outline.
-  std::vector<std::pair<std::uint32_t, std::size_t>> by_first_block;
-  for (std::size_t k = 0; k < split.patches.size(); ++k) by_first_block.emplace_back(split.patches[k].blocks.front(), k);
-  std::sort(by_first_block.begin(), by_first_block.end());
-  std::vector<std::size_t> sizes(split.patches.size());
-  for (std::size_t k = 0; k < split.patches.size(); ++k) sizes[k] = split.patches[k].blocks.size();
+  const std::size_t pieces = split.patches.size();
   const double cell_area = grid_.cellSize() * grid_.cellSize();
   joinUnseenGaps(grid_, split.patches, accepted.plane.normal.cast<double>(), accepted.plane.point.cast<double>(),
                  config_.epsilon, std::max<std::size_t>(config_.min_patch_blocks, 1), config_.min_patch_area / cell_area);
-  auto runsOf = [&](const Patch& patch) {
-    const auto found = std::lower_bound(by_first_block.begin(), by_first_block.end(),
-                                        std::make_pair(patch.blocks.front(), std::size_t{0}));
-    if (found == by_first_block.end() || found->first != patch.blocks.front() ||
-        sizes[found->second] != patch.blocks.size()) {
-      return std::vector<Segment>{};
-    }
-    return std::move(split.outline_runs[found->second]);
-  };
+  // A join (a wall's pieces) leaves fewer patches: theirs are rasterised again for
+  // their outlines.
+  if (split.patches.size() != pieces) split.outline_runs.assign(split.patches.size(), {});
   const bool level = std::abs(accepted.plane.normal.z()) >= std::cos(radians(45.0));
   const double min_width =
       (level ? config_.min_level_patch_width_cells : config_.min_patch_width_cells) * grid_.cellSize();
   std::vector<std::uint32_t> taken;
-  for (Patch& patch : split.patches) {
+  for (std::size_t k = 0; k < split.patches.size(); ++k) {
+    Patch& patch = split.patches[k];
     if (patch.surface * cell_area < config_.min_patch_area ||
         patch.blocks.size() < static_cast<std::size_t>(config_.min_patch_blocks) ||
         isThin(grid_, patch, accepted.plane, min_width, patch_threads_)) {
@@ -240,7 +229,7 @@ bool Detector::accept(std::size_t index) {
     plane.candidates = since_acceptance_;
     for (const std::uint32_t id : patch.blocks) patches_.labels[id] = plane.id;
     taken.insert(taken.end(), patch.blocks.begin(), patch.blocks.end());
-    patches_.outline_runs.push_back(runsOf(patch));
+    patches_.outline_runs.push_back(std::move(split.outline_runs[k]));
     patches_.blocks.push_back(std::move(patch.blocks));
     patches_.outline_frames.push_back(
         OutlineFrame{accepted.plane.normal.cast<double>(), accepted.plane.point.cast<double>(), true});
