@@ -354,9 +354,11 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
   // Patches in the order of their first block (the order of the blocks' first raster
   // cells), then largest first.
   std::vector<std::int32_t> patch_of_root(runs.size(), -1);
+  std::vector<std::uint32_t> root_of_run(runs.size());
+  for (std::size_t r = 0; r < runs.size(); ++r) root_of_run[r] = static_cast<std::uint32_t>(sets.find(r));
   std::vector<Patch> patches;
   for (std::size_t k = 0; k < blocks.size(); ++k) {
-    const std::size_t root = sets.find(run_of_segment[footprints.first_of_block[k]]);
+    const std::size_t root = root_of_run[run_of_segment[footprints.first_of_block[k]]];
     if (patch_of_root[root] < 0) {
       patch_of_root[root] = static_cast<std::int32_t>(patches.size());
       patches.emplace_back();
@@ -370,12 +372,12 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
   std::vector<std::vector<Segment>> outline_runs(patches.size());
   if (gap_cells > 1) {
     for (std::size_t f = 0; f < column_runs.fine_runs.size(); ++f) {
-      const auto patch = static_cast<std::size_t>(patch_of_root[sets.find(column_runs.parent_of_fine_run[f])]);
+      const auto patch = static_cast<std::size_t>(patch_of_root[root_of_run[column_runs.parent_of_fine_run[f]]]);
       outline_runs[patch].push_back(column_runs.fine_runs[f]);
     }
   } else if (gap_cells == 1) {
     for (std::size_t r = 0; r < runs.size(); ++r) {
-      outline_runs[static_cast<std::size_t>(patch_of_root[sets.find(r)])].push_back(runs[r]);
+      outline_runs[static_cast<std::size_t>(patch_of_root[root_of_run[r]])].push_back(runs[r]);
     }
   }
   std::vector<std::size_t> largest_first(patches.size());
