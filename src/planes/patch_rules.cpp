@@ -15,6 +15,25 @@ namespace {
 // floor's 150 000, and chunk by chunk in order whatever the thread count.
 constexpr std::size_t kChunk = 8192;
 
+// The sums of add(sums, n) over n < count, taken chunk by chunk and the chunks'
+// sums combined in order: the same result at any thread count.
+template <typename Sums, typename Add, typename Combine>
+Sums sumInChunks(std::size_t count, int threads, Add add, Combine combine) {
+  const std::size_t chunks = (count + kChunk - 1) / kChunk;
+  std::vector<Sums> partial(chunks);
+  const auto chunk_count = static_cast<std::int64_t>(chunks);
+#pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (threads > 1 && chunks > 1)
+  for (std::int64_t chunk = 0; chunk < chunk_count; ++chunk) {
+    const std::size_t end = std::min(count, static_cast<std::size_t>(chunk + 1) * kChunk);
+    for (std::size_t n = static_cast<std::size_t>(chunk) * kChunk; n < end; ++n) {
+      add(partial[static_cast<std::size_t>(chunk)], n);
+    }
+  }
+  Sums total{};
+  for (const Sums& sums : partial) combine(total, sums);
+  return total;
+}
+
 }  // namespace
 
 std::vector<std::uint32_t> withEdges(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
@@ -79,30 +98,22 @@ bool spreadExceeds(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& di
     double upper = 0.0;
     double weight = 0.0;
   };
-  // Summed chunk by chunk, the chunks in order: the same sums at any thread count.
-  const std::size_t chunks = (ids.size() + kChunk - 1) / kChunk;
-  std::vector<Bounds> partial(chunks);
-  const auto chunk_count = static_cast<std::int64_t>(chunks);
-#pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (threads > 1 && chunks > 1)
-  for (std::int64_t chunk = 0; chunk < chunk_count; ++chunk) {
-    Bounds& bounds = partial[static_cast<std::size_t>(chunk)];
-    const std::size_t end = std::min(ids.size(), static_cast<std::size_t>(chunk + 1) * kChunk);
-    for (std::size_t n = static_cast<std::size_t>(chunk) * kChunk; n < end; ++n) {
-      const std::uint32_t id = ids[n];
-      const double cosine = std::min(1.0F, std::abs(directions[id].dot(plane.normal)));
-      const double sine = std::sqrt(std::max(0.0, 1.0 - cosine * cosine));
-      const double surface = grid.blocks()[id].surface;
-      bounds.lower += surface * sine;
-      bounds.upper += surface * (sine / cosine);
-      bounds.weight += surface;
-    }
-  }
-  Bounds total;
-  for (const Bounds& bounds : partial) {
-    total.lower += bounds.lower;
-    total.upper += bounds.upper;
-    total.weight += bounds.weight;
-  }
+  const Bounds total = sumInChunks<Bounds>(
+      ids.size(), threads,
+      [&](Bounds& bounds, std::size_t n) {
+        const std::uint32_t id = ids[n];
+        const double cosine = std::min(1.0F, std::abs(directions[id].dot(plane.normal)));
+        const double sine = std::sqrt(std::max(0.0, 1.0 - cosine * cosine));
+        const double surface = grid.blocks()[id].surface;
+        bounds.lower += surface * sine;
+        bounds.upper += surface * (sine / cosine);
+        bounds.weight += surface;
+      },
+      [](Bounds& total_bounds, const Bounds& bounds) {
+        total_bounds.lower += bounds.lower;
+        total_bounds.upper += bounds.upper;
+        total_bounds.weight += bounds.weight;
+      });
   if (!(total.weight > 0.0)) return directionSpread(grid, directions, ids, plane) > max_deg;
   const double degrees = 180.0 / std::numbers::pi;
   if (total.lower / total.weight * degrees > max_deg * (1.0 + kMargin)) return true;
@@ -111,22 +122,14 @@ bool spreadExceeds(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& di
 }
 
 bool isThin(const BlockGrid& grid, const Patch& patch, const CandidatePlane& plane, double min_width, int threads) {
-  // Summed chunk by chunk, the chunks in order: the same sums at any thread count.
-  const std::size_t chunks = (patch.blocks.size() + kChunk - 1) / kChunk;
-  std::vector<PcaSums> partial(chunks);
-  const auto chunk_count = static_cast<std::int64_t>(chunks);
-#pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (threads > 1 && chunks > 1)
-  for (std::int64_t chunk = 0; chunk < chunk_count; ++chunk) {
-    PcaSums& pca = partial[static_cast<std::size_t>(chunk)];
-    const std::size_t end = std::min(patch.blocks.size(), static_cast<std::size_t>(chunk + 1) * kChunk);
-    for (std::size_t n = static_cast<std::size_t>(chunk) * kChunk; n < end; ++n) {
-      const PlaneBlock& block = grid.blocks()[patch.blocks[n]];
-      pca.addBlock((block.point - plane.point).cast<double>(), block.vertical ? 0.5 * (block.top - block.bottom) : 0.0,
-                   1.0);
-    }
-  }
-  PcaSums pca;
-  for (const PcaSums& sums : partial) pca.addShifted(sums, Eigen::Vector3d::Zero());
+  const PcaSums pca = sumInChunks<PcaSums>(
+      patch.blocks.size(), threads,
+      [&](PcaSums& sums, std::size_t n) {
+        const PlaneBlock& block = grid.blocks()[patch.blocks[n]];
+        sums.addBlock((block.point - plane.point).cast<double>(),
+                      block.vertical ? 0.5 * (block.top - block.bottom) : 0.0, 1.0);
+      },
+      [](PcaSums& total, const PcaSums& sums) { total.addShifted(sums, Eigen::Vector3d::Zero()); });
   // The spread across the plane: the covariance in the plane's own basis.
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;
