@@ -113,7 +113,12 @@ struct ColumnRuns {
     };
     std::vector<Numbered> order(segments.size());
     for (std::uint32_t n = 0; n < segments.size(); ++n) order[n] = {segments[n], n};
-    stableSortBy(order, [](const Numbered& item) { return item.segment.v_low; }, threads);
+    // A level plane's blocks come row by row over the map's grid (ids ascending), and its
+    // raster is nearly the grid's: its footprints nearly always come in order of v_low
+    // already, and the first sort would leave them as they are.
+    const bool by_v = std::is_sorted(segments.begin(), segments.end(),
+                                     [](const Segment& a, const Segment& b) { return a.v_low < b.v_low; });
+    if (!by_v) stableSortBy(order, [](const Numbered& item) { return item.segment.v_low; }, threads);
     stableSortBy(order, [](const Numbered& item) { return item.segment.u; }, threads);
     for (const auto& [segment, n] : order) {
       if (runs.empty() || runs.back().u != segment.u ||
