@@ -131,6 +131,7 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
     const int bin = bin_of[id];
     if (bin < 0) {
       undirected_.push_back(id);
+      undirected_points_.push_back(grid.blocks()[id].point);
       continue;
     }
     directed.push_back(id);
@@ -475,8 +476,9 @@ std::vector<std::uint32_t> PlaneScorer::near(const CandidatePlane& plane, float 
   // Tiles whose blocks all match the plane are left out: the caller has those.
   const Query matching{plane.normal, query.offset, cos_kappa_, epsilon_};
   collect(query, &matching, ids);
-  for (const std::uint32_t id : undirected_) {
-    if (taken_[id] == 0 && std::abs(query.normal.dot(grid_.blocks()[id].point) + query.offset) < query.epsilon) {
+  for (std::size_t n = 0; n < undirected_.size(); ++n) {
+    const std::uint32_t id = undirected_[n];
+    if (std::abs(query.normal.dot(undirected_points_[n]) + query.offset) < query.epsilon && taken_[id] == 0) {
       ids.insert(id);
     }
   }

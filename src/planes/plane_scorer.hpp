@@ -101,6 +101,7 @@ class PlaneScorer {
   std::vector<std::uint32_t> layer_of_tile_;
   std::vector<std::uint32_t> bin_of_layer_;
   std::vector<std::uint32_t> undirected_;           // blocks without a direction (not in the index)
+  std::vector<Eigen::Vector3f> undirected_points_;  // theirs: each accepted plane's edges pass over them
 };
 
 }  // namespace mlmap
