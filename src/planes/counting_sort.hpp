@@ -15,8 +15,8 @@ namespace mlmap {
 //
 // With `threads` > 1 a long list is counted and placed in as many contiguous slices at
 // once: a key's items from an earlier slice go first, so the order is the same.
-template <typename Item, typename Key>
-void stableSortBy(std::vector<Item>& items, Key key, int threads = 1) {
+template <typename Item, typename Allocator, typename Key>
+void stableSortBy(std::vector<Item, Allocator>& items, Key key, int threads = 1) {
   if (items.empty()) return;
   constexpr std::size_t kParallelItems = 50000;
   const auto count = static_cast<std::int64_t>(items.size());
@@ -53,7 +53,8 @@ void stableSortBy(std::vector<Item>& items, Key key, int threads = 1) {
       placed += members;
     }
   }
-  std::vector<Item> sorted(items.size());
+  // Every slot is written below (with a FillVector's allocator, not zeroed first).
+  std::vector<Item, Allocator> sorted(items.size());
 #pragma omp parallel for schedule(static, 1) num_threads(slices) if (slices > 1)
   for (int slice = 0; slice < slices; ++slice) {
     std::uint32_t* positions = next.data() + static_cast<std::size_t>(slice) * range;

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "counting_sort.hpp"
+#include "fill_vector.hpp"
 #include "outline_runs.hpp"
 
 namespace mlmap {
@@ -40,8 +41,8 @@ class DisjointSets {
 // point, else the cells of points along its extent a cell apart. Block k's segments are
 // [first_of_block[k], first_of_block[k + 1]), the one of its point first.
 struct Footprints {
-  std::vector<Segment> segments;
-  std::vector<std::size_t> first_of_block;
+  FillVector<Segment> segments;
+  FillVector<std::size_t> first_of_block;
 
   Footprints(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& u_axis,
              const Eigen::Vector3d& v_axis, const Eigen::Vector3d& point, int threads = 1) {
@@ -101,18 +102,22 @@ struct Footprints {
 // `fine_gap` under join_gap, also the runs at that gap, each inside one run (its parent).
 struct ColumnRuns {
   std::vector<Segment> runs;
-  std::vector<std::uint32_t> run_of_segment;
+  FillVector<std::uint32_t> run_of_segment;
   std::vector<Segment> fine_runs;
   std::vector<std::uint32_t> parent_of_fine_run;
 
-  ColumnRuns(const std::vector<Segment>& segments, int join_gap, int fine_gap = 0, int threads = 1)
+  ColumnRuns(const FillVector<Segment>& segments, int join_gap, int fine_gap = 0, int threads = 1)
       : run_of_segment(segments.size()) {
     struct Numbered {
       Segment segment;
       std::uint32_t number;
     };
-    std::vector<Numbered> order(segments.size());
-    for (std::uint32_t n = 0; n < segments.size(); ++n) order[n] = {segments[n], n};
+    FillVector<Numbered> order(segments.size());
+    const auto count = static_cast<std::int64_t>(segments.size());
+#pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (threads > 1 && segments.size() >= kParallelBlocks)
+    for (std::int64_t n = 0; n < count; ++n) {
+      order[static_cast<std::size_t>(n)] = {segments[static_cast<std::size_t>(n)], static_cast<std::uint32_t>(n)};
+    }
     // A level plane's blocks come row by row over the map's grid (ids ascending), and its
     // raster is nearly the grid's: its footprints nearly always come in order of v_low
     // already, and the first sort would leave them as they are.
@@ -324,7 +329,7 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
   Eigen::Vector3d v_axis;
   planeBasis(normal, u_axis, v_axis);
   const Footprints footprints(grid, blocks, u_axis, v_axis, point, threads);
-  const std::vector<Segment>& segments = footprints.segments;
+  const FillVector<Segment>& segments = footprints.segments;
   // Cells are connected within gap_cells (Chebyshev). Not cell by cell (a wall at 2 cm
   // rasterises to over half a million cells): in each raster column u, segments less
   // than gap_cells apart join into runs, and runs of columns up to gap_cells apart
@@ -334,7 +339,7 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
   // on come out of the same pass.
   const ColumnRuns column_runs(segments, gap_cells, gap_cells > 1 ? 1 : 0, threads);
   const std::vector<Segment>& runs = column_runs.runs;
-  const std::vector<std::uint32_t>& run_of_segment = column_runs.run_of_segment;
+  const FillVector<std::uint32_t>& run_of_segment = column_runs.run_of_segment;
   // The runs of each column: [column_first[u − min_u], column_first[u − min_u + 1]).
   const std::int32_t min_u = runs.front().u;
   const auto columns = static_cast<std::size_t>(static_cast<std::int64_t>(runs.back().u) - min_u + 1);

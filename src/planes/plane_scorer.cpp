@@ -108,7 +108,7 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   const auto bins = static_cast<std::size_t>(binCount());
   // Each bin's axis: the mean of its members' directions (so a bin of wall blocks,
   // whose directions are level, has a level axis), and a frame across it.
-  std::vector<std::int32_t> bin_of(grid.size(), -1);
+  FillVector<std::int32_t> bin_of(grid.size());
   const auto count = static_cast<std::int64_t>(grid.size());
 #ifdef _OPENMP
   // Small maps build their index on one thread: there a parallel region saves little,
@@ -121,7 +121,7 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
 #pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
   for (std::int64_t id = 0; id < count; ++id) {
     const Eigen::Vector3f& d = directions[static_cast<std::size_t>(id)];
-    if (d.squaredNorm() > 0.0F) bin_of[static_cast<std::size_t>(id)] = binOf(d);
+    bin_of[static_cast<std::size_t>(id)] = d.squaredNorm() > 0.0F ? binOf(d) : -1;
   }
   std::vector<Eigen::Vector3f> sums(bins, Eigen::Vector3f::Zero());
   std::vector<Eigen::Vector3f> first(bins, Eigen::Vector3f::Zero());
@@ -156,7 +156,7 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
     std::uint32_t id;
   };
   // Each block on its own, so on all threads.
-  std::vector<Place> order(directed.size());
+  FillVector<Place> order(directed.size());
   const auto directed_count = static_cast<std::int64_t>(directed.size());
 #pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
   for (std::int64_t n = 0; n < directed_count; ++n) {
@@ -248,8 +248,8 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   // The order's memory goes first, for the arrays to reuse: fresh pages cost a fault
   // each (a 4 KB page in ~1.7 µs here), reused ones nothing.
   const std::size_t indexed = order.size();
-  std::vector<Place>().swap(order);
-  std::vector<std::int32_t>().swap(bin_of);
+  FillVector<Place>().swap(order);
+  FillVector<std::int32_t>().swap(bin_of);
   std::vector<std::uint32_t>().swap(directed);
   ids_.resize(indexed);
   points_.resize(indexed);

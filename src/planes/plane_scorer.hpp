@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "mlmap/planes/block_grid.hpp"
+#include "fill_vector.hpp"
 #include "id_set.hpp"
 #include "pca_sums.hpp"
 
@@ -89,11 +90,11 @@ class PlaneScorer {
   std::vector<Node> layers_;  // children: tiles
   std::vector<Node> tiles_;   // children: blocks
   // Blocks ordered by bin, layer, tile, id (structure of arrays: a pass streams).
-  std::vector<std::uint32_t> ids_;
-  std::vector<Eigen::Vector3f> points_;
-  std::vector<Eigen::Vector3f> block_directions_;
-  std::vector<float> surfaces_;
-  std::vector<float> half_depths_;  // 0 for horizontal blocks
+  FillVector<std::uint32_t> ids_;
+  FillVector<Eigen::Vector3f> points_;
+  FillVector<Eigen::Vector3f> block_directions_;
+  FillVector<float> surfaces_;
+  FillVector<float> half_depths_;  // 0 for horizontal blocks
   std::vector<std::uint8_t> order_taken_;
   std::vector<std::uint8_t> taken_;                 // by block id
   std::vector<std::uint32_t> position_;             // block id -> index in the arrays, UINT32_MAX for none
