@@ -111,7 +111,10 @@ Eigen::Vector3f orientConsistently(const Eigen::Vector3f& normal) {
 }
 
 std::vector<Eigen::Vector3f> directionVectors(const BlockGrid& grid, const DirectionConfig& config) {
-  std::vector<Eigen::Vector3f> directions(grid.size(), Eigen::Vector3f::Zero());
+  // Not zeroed first: the loop writes every block's (each lies in one cell), and Eigen's
+  // vectors are left uninitialised by their constructor, so the pages are first touched
+  // by the threads that fill them.
+  std::vector<Eigen::Vector3f> directions(grid.size());
   const auto cells = static_cast<std::int64_t>(grid.cellCount());
   const double min_spread = 0.1 * grid.cellSize() * grid.cellSize();
   const auto& blocks = grid.blocks();

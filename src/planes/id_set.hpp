@@ -17,7 +17,11 @@ class IdSet {
   void insert(std::uint32_t id) { words_[id >> 6] |= std::uint64_t{1} << (id & 63U); }
 
   std::vector<std::uint32_t> ascending() const {
+    std::size_t count = 0;
+    for (const std::uint64_t word : words_) count += static_cast<std::size_t>(std::popcount(word));
+    // Reserved whole: a floor's 150 000 ids grown by doubling touched twice the memory.
     std::vector<std::uint32_t> ids;
+    ids.reserve(count);
     for (std::size_t w = 0; w < words_.size(); ++w) {
       for (std::uint64_t word = words_[w]; word != 0; word &= word - 1) {
         ids.push_back(static_cast<std::uint32_t>(64 * w + static_cast<std::size_t>(std::countr_zero(word))));
