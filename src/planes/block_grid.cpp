@@ -113,23 +113,25 @@ BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_siz
                 std::to_string(columns_) + " cells in its bounding box");
   }
   // The map's cell numbers on the grid first, then renumbered row by row.
-  grid_.assign(static_cast<std::size_t>(rows_ * columns_), -1);
+  std::vector<std::int32_t> grid(static_cast<std::size_t>(rows_ * columns_), -1);
   for (std::size_t n = 0; n < cell_count; ++n) {
     const CellIndex cell = map.cellAt(n);
-    grid_[static_cast<std::size_t>((cell.i - min_i_) * columns_ + (cell.j - min_j_))] = static_cast<std::int32_t>(n);
+    grid[static_cast<std::size_t>((cell.i - min_i_) * columns_ + (cell.j - min_j_))] = static_cast<std::int32_t>(n);
   }
   blocks_.reserve(map.blockCount());
   cell_first_.reserve(cell_count + 1);
   map_cell_.reserve(cell_count);
-  for (std::int32_t& slot : grid_) {
-    if (slot < 0) continue;
-    const auto map_cell = static_cast<std::size_t>(slot);
-    slot = static_cast<std::int32_t>(map_cell_.size());
+  first_id_from_.resize(grid.size() + 1);
+  for (std::size_t position = 0; position < grid.size(); ++position) {
+    first_id_from_[position] = static_cast<std::uint32_t>(blocks_.size());
+    if (grid[position] < 0) continue;
+    const auto map_cell = static_cast<std::size_t>(grid[position]);
     map_cell_.push_back(static_cast<std::uint32_t>(map_cell));
     const CellIndex cell = map.cellAt(map_cell);
     appendStacks(map.blocksAt(map_cell), cell, map.cellCenter(cell), cell_size_, rule, blocks_);
     cell_first_.push_back(static_cast<std::uint32_t>(blocks_.size()));
   }
+  first_id_from_.back() = static_cast<std::uint32_t>(blocks_.size());
 }
 
 std::vector<std::uint32_t> BlockGrid::idsInMapOrder() const {

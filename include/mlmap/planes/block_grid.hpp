@@ -86,16 +86,10 @@ class BlockGrid {
     const std::int64_t column_begin = std::max<std::int64_t>(j_low - min_j_, 0);
     const std::int64_t column_end = std::min<std::int64_t>(j_high - min_j_, columns_ - 1);
     for (std::int64_t row = row_begin; row <= row_end; ++row) {
-      // The row's cells in the window hold one run of consecutive ids: from the first
-      // occupied cell's first block to the last occupied cell's last.
-      const std::int32_t* line = grid_.data() + row * columns_;
-      std::int64_t first = column_begin;
-      while (first <= column_end && line[first] < 0) ++first;
-      if (first > column_end) continue;
-      std::int64_t last = column_end;
-      while (line[last] < 0) --last;
-      const std::uint32_t end = cell_first_[static_cast<std::size_t>(line[last]) + 1];
-      for (std::uint32_t id = cell_first_[static_cast<std::size_t>(line[first])]; id < end; ++id) visit(id);
+      // The row's cells in the window hold one run of consecutive ids.
+      const std::uint32_t* line = first_id_from_.data() + row * columns_;
+      const std::uint32_t end = line[column_end + 1];
+      for (std::uint32_t id = line[column_begin]; id < end; ++id) visit(id);
     }
   }
 
@@ -104,7 +98,12 @@ class BlockGrid {
   std::vector<PlaneBlock> blocks_;
   std::vector<std::uint32_t> cell_first_;  // per cell number, plus one past the end
   std::vector<std::uint32_t> map_cell_;    // per cell number: the map's number of that cell
-  std::vector<std::int32_t> grid_;         // dense rows × columns of cell numbers, −1 empty
+  // Per position of the dense rows × columns grid, and one past the end: the first
+  // block id of the first occupied cell at or after it, row by row (the blocks' number
+  // when there is none). A row's blocks in columns c0..c1 are the ids from its entry
+  // at c0 to its entry at c1 + 1: two lookups, where scanning the window's cells for
+  // occupied ones mispredicted on every gap between scan lines.
+  std::vector<std::uint32_t> first_id_from_;
   std::int64_t min_i_ = 0;
   std::int64_t min_j_ = 0;
   std::int64_t rows_ = 0;
