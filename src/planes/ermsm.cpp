@@ -391,9 +391,8 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   // Block heights average several points, so their scatter stays below the points':
   // 3 σ, capped, and never less than a cell (block points sit at cell centres).
   if (config.epsilon <= 0.0) config.epsilon = std::max(map.cellSize(), std::min(3.0 * config.noise, 0.05));
-  for (std::size_t n = 0; n < map.cellCount(); ++n) {
-    for (Block& block : map.mutableBlocksAt(n)) block.plane = 0;
-  }
+  // The blocks' old labels need no clearing: the write-back at the end labels every
+  // map block (each lies in one eRMSM block), 0 where no patch took it.
   stats.stages.noise = stage();
   // A level rung is fused from a few points (under ten): its variance is a good part
   // of one point's σ², a table top's far below it.

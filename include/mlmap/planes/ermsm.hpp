@@ -54,7 +54,7 @@ struct ErmsmConfig {
 // Seconds per stage of detectPlanes, for profiling: the first three make up
 // ErmsmStats::direction_seconds, the rest detection_seconds.
 struct ErmsmStageSeconds {
-  double noise = 0.0;       // the range-noise estimate, old labels cleared
+  double noise = 0.0;       // the range-noise estimate
   double grid = 0.0;        // eRMSM blocks (BlockGrid)
   double directions = 0.0;  // direction vectors
   double index = 0.0;       // the scorer's index, the seedable blocks
