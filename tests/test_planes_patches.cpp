@@ -351,3 +351,28 @@ TEST_CASE("outlineOf: holes, and islands inside them, leave the outer boundary a
     for (std::size_t k = 0; k < full.size(); ++k) CHECK((outline[k] - full[k]).norm() < 1e-12);
   }
 }
+
+TEST_CASE("outlineOfRuns: the corners of a rectangle, an L and two cells touching at a corner, counter-clockwise from the lowest") {
+  // On a level plane through the origin the raster's u and v are x and y: with cells of
+  // 1 m, a corner (u, v) is the point (u, v, 0).
+  const Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  auto corners = [&](const std::vector<Segment>& runs) {
+    std::vector<Eigen::Vector2i> result;
+    for (const Eigen::Vector3d& corner : outlineOfRuns(runs, 1.0, normal, origin)) {
+      CHECK(std::abs(corner.z()) < 1e-12);
+      result.emplace_back(static_cast<int>(std::lround(corner.x())), static_cast<int>(std::lround(corner.y())));
+    }
+    return result;
+  };
+  using Corners = std::vector<Eigen::Vector2i>;
+  // Three columns of two cells.
+  CHECK(corners({{0, 0, 1}, {1, 0, 1}, {2, 0, 1}}) == Corners{{0, 0}, {3, 0}, {3, 2}, {0, 2}});
+  // A column of three with a row of two more along its foot.
+  CHECK(corners({{0, 0, 2}, {1, 0, 0}, {2, 0, 0}}) == Corners{{0, 0}, {3, 0}, {3, 1}, {1, 1}, {1, 3}, {0, 3}});
+  // Touching at (1, 1) only: one loop round both, through that vertex twice.
+  CHECK(corners({{0, 0, 0}, {1, 1, 1}}) == Corners{{0, 0}, {1, 0}, {1, 1}, {2, 1}, {2, 2}, {1, 2}, {1, 1}, {0, 1}});
+  // A ring of eight round a hole: the outer square only.
+  CHECK(corners({{0, 0, 2}, {1, 0, 0}, {1, 2, 2}, {2, 0, 2}}) == Corners{{0, 0}, {3, 0}, {3, 3}, {0, 3}});
+  CHECK(corners({}).empty());
+}
