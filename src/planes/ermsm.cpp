@@ -57,7 +57,7 @@ int teamSize(int threads) {
 // by chunk of the map's cells on all threads, since that order visits the grid (and
 // the directions) at random, a cache miss per cell.
 std::vector<std::uint32_t> seedableBlocks(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
-                                          int threads) {
+                                          [[maybe_unused]] int threads) {
   const auto cells = static_cast<std::int64_t>(grid.cellCount());
   FillVector<std::uint32_t> grid_cell_of(grid.cellCount());  // by the map's cell number; a bijection
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
