@@ -258,7 +258,9 @@ bool Detector::accept(std::size_t index) {
     plane.id = static_cast<std::int32_t>(patches_.planes.size() + 1);
     plane.source = accepted_;
     plane.candidates = since_acceptance_;
-    for (const std::uint32_t id : patch.blocks) patches_.labels[id] = plane.id;
+    const auto patch_size = static_cast<std::int64_t>(patch.blocks.size());
+#pragma omp parallel for schedule(static) num_threads(patch_threads_) if (patch_threads_ > 1 && patch_size > 20000)
+    for (std::int64_t n = 0; n < patch_size; ++n) patches_.labels[patch.blocks[static_cast<std::size_t>(n)]] = plane.id;
     taken.insert(taken.end(), patch.blocks.begin(), patch.blocks.end());
     patches_.outline_runs.push_back(std::move(split.outline_runs[k]));
     patches_.blocks.push_back(std::move(patch.blocks));
