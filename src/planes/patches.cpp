@@ -201,14 +201,27 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
   std::vector<std::int32_t> patch_of_root(runs.size(), -1);
   std::vector<std::uint32_t> root_of_run(runs.size());
   for (std::size_t r = 0; r < runs.size(); ++r) root_of_run[r] = static_cast<std::uint32_t>(sets.find(r));
-  std::vector<Patch> patches;
-  for (std::size_t k = 0; k < blocks.size(); ++k) {
-    const std::size_t root = root_of_run[run_of_segment[footprints.first_of_block[k]]];
+  // Each block's component on all threads; then, in block order, the patches numbered,
+  // counted, and filled (each patch's blocks and surface sum in block order).
+  const auto block_count = static_cast<std::int64_t>(blocks.size());
+  FillVector<std::uint32_t> root_of_block(blocks.size());
+#pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (threads > 1 && blocks.size() >= kParallelBlocks)
+  for (std::int64_t k = 0; k < block_count; ++k) {
+    const auto n = static_cast<std::size_t>(k);
+    root_of_block[n] = root_of_run[run_of_segment[footprints.first_of_block[n]]];
+  }
+  std::vector<std::size_t> patch_sizes;
+  for (const std::uint32_t root : root_of_block) {
     if (patch_of_root[root] < 0) {
-      patch_of_root[root] = static_cast<std::int32_t>(patches.size());
-      patches.emplace_back();
+      patch_of_root[root] = static_cast<std::int32_t>(patch_sizes.size());
+      patch_sizes.push_back(0);
     }
-    Patch& patch = patches[static_cast<std::size_t>(patch_of_root[root])];
+    ++patch_sizes[static_cast<std::size_t>(patch_of_root[root])];
+  }
+  std::vector<Patch> patches(patch_sizes.size());
+  for (std::size_t k = 0; k < patches.size(); ++k) patches[k].blocks.reserve(patch_sizes[k]);
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    Patch& patch = patches[static_cast<std::size_t>(patch_of_root[root_of_block[k]])];
     patch.blocks.push_back(blocks[k]);
     patch.surface += grid.blocks()[blocks[k]].surface;
   }
