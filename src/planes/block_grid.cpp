@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "fill_vector.hpp"
 #include "mlmap/error.hpp"
 
 namespace mlmap {
@@ -134,14 +135,32 @@ BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_siz
   first_id_from_.back() = static_cast<std::uint32_t>(blocks_.size());
 }
 
-std::vector<std::uint32_t> BlockGrid::idsInMapOrder() const {
-  std::vector<std::uint32_t> cell_of_map_cell(map_cell_.size());
-  for (std::uint32_t n = 0; n < map_cell_.size(); ++n) cell_of_map_cell[map_cell_[n]] = n;
-  std::vector<std::uint32_t> ids;
-  ids.reserve(blocks_.size());
-  for (const std::uint32_t n : cell_of_map_cell) {
-    for (std::uint32_t id = cell_first_[n]; id < cell_first_[n + 1]; ++id) ids.push_back(id);
+std::vector<std::uint32_t> BlockGrid::idsInMapOrder(std::span<const std::uint8_t> keep,
+                                                    [[maybe_unused]] int threads) const {
+  const auto cells = static_cast<std::int64_t>(map_cell_.size());
+  FillVector<std::uint32_t> cell_of_map_cell(map_cell_.size());  // a bijection
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  for (std::int64_t n = 0; n < cells; ++n) {
+    cell_of_map_cell[map_cell_[static_cast<std::size_t>(n)]] = static_cast<std::uint32_t>(n);
   }
+  constexpr std::int64_t kChunkCells = 8192;
+  const std::int64_t chunks = (cells + kChunkCells - 1) / kChunkCells;
+  std::vector<std::vector<std::uint32_t>> parts(static_cast<std::size_t>(chunks));
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (threads > 1)
+  for (std::int64_t chunk = 0; chunk < chunks; ++chunk) {
+    std::vector<std::uint32_t>& part = parts[static_cast<std::size_t>(chunk)];
+    for (std::int64_t n = chunk * kChunkCells; n < std::min(cells, (chunk + 1) * kChunkCells); ++n) {
+      const std::uint32_t cell = cell_of_map_cell[static_cast<std::size_t>(n)];
+      for (std::uint32_t id = cell_first_[cell]; id < cell_first_[cell + 1]; ++id) {
+        if (keep.empty() || keep[id] != 0) part.push_back(id);
+      }
+    }
+  }
+  std::size_t total = 0;
+  for (const auto& part : parts) total += part.size();
+  std::vector<std::uint32_t> ids;
+  ids.reserve(total);
+  for (const auto& part : parts) ids.insert(ids.end(), part.begin(), part.end());
   return ids;
 }
 

@@ -53,38 +53,6 @@ int teamSize(int threads) {
 #endif
 }
 
-// The blocks with a direction vector, in the order of BlockGrid::idsInMapOrder: chunk
-// by chunk of the map's cells on all threads, since that order visits the grid (and
-// the directions) at random, a cache miss per cell.
-std::vector<std::uint32_t> seedableBlocks(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
-                                          [[maybe_unused]] int threads) {
-  const auto cells = static_cast<std::int64_t>(grid.cellCount());
-  FillVector<std::uint32_t> grid_cell_of(grid.cellCount());  // by the map's cell number; a bijection
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-  for (std::int64_t n = 0; n < cells; ++n) {
-    grid_cell_of[grid.mapCellOf(static_cast<std::size_t>(n))] = static_cast<std::uint32_t>(n);
-  }
-  constexpr std::int64_t kChunkCells = 8192;
-  const std::int64_t chunks = (cells + kChunkCells - 1) / kChunkCells;
-  std::vector<std::vector<std::uint32_t>> parts(static_cast<std::size_t>(chunks));
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (threads > 1)
-  for (std::int64_t chunk = 0; chunk < chunks; ++chunk) {
-    std::vector<std::uint32_t>& part = parts[static_cast<std::size_t>(chunk)];
-    for (std::int64_t n = chunk * kChunkCells; n < std::min(cells, (chunk + 1) * kChunkCells); ++n) {
-      const std::uint32_t cell = grid_cell_of[static_cast<std::size_t>(n)];
-      for (std::uint32_t id = grid.firstBlockOfCell(cell); id < grid.firstBlockOfCell(cell + 1); ++id) {
-        if (directions[id].squaredNorm() > 0.0F) part.push_back(id);
-      }
-    }
-  }
-  std::size_t total = 0;
-  for (const auto& part : parts) total += part.size();
-  std::vector<std::uint32_t> ids;
-  ids.reserve(total);
-  for (const auto& part : parts) ids.insert(ids.end(), part.begin(), part.end());
-  return ids;
-}
-
 // The range noise of the map's points: a vertical block keeps the variance of its
 // top measurement (section IV), so their median is a measurement's. 1 cm without any.
 double rangeNoise(const MLMap& map) {
@@ -110,7 +78,13 @@ class Detector {
         min_score_(config.min_area / (grid.cellSize() * grid.cellSize())),
         patch_threads_(teamSize(patchPassThreads(grid, config.threads))) {
     patches_.labels.assign(grid.size(), 0);
-    seedable_ = seedableBlocks(grid, directions, patch_threads_);
+    FillVector<std::uint8_t> directed(grid.size());
+    const auto blocks = static_cast<std::int64_t>(grid.size());
+#pragma omp parallel for schedule(static) num_threads(patch_threads_) if (patch_threads_ > 1)
+    for (std::int64_t id = 0; id < blocks; ++id) {
+      directed[static_cast<std::size_t>(id)] = directions[static_cast<std::size_t>(id)].squaredNorm() > 0.0F ? 1 : 0;
+    }
+    seedable_ = grid.idsInMapOrder(directed, patch_threads_);
   }
 
   // Algorithm 1; the patches it leaves, coplanar pieces merged.

@@ -249,10 +249,6 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
     tile_of_.push_back(static_cast<std::uint32_t>(tiles_.size() - 1));
     tiles_.back().end = static_cast<std::uint32_t>(k + 1);
   }
-  // The blocks' data in index order, on all threads: scattered from a pass over the
-  // grid in id order, which reads each block once and whole (a gather in index order
-  // read a block's cache lines twice over, once for the floor, once for the ceiling
-  // sharing its cells, and the blocks are far larger than what is kept of them).
   // Each block's place on its own: on all threads (the writes land all over position_).
 #pragma omp parallel for schedule(static) num_threads(team) if (team > 1)
   for (std::int64_t k = 0; k < directed_count; ++k) {
@@ -264,6 +260,10 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   FillVector<Place>().swap(order);
   FillVector<std::int32_t>().swap(bin_of);
   std::vector<std::uint32_t>().swap(directed);
+  // The blocks' data in index order, on all threads: scattered from a pass over the
+  // grid in id order, which reads each block once and whole (a gather in index order
+  // read a block's cache lines twice over, once for the floor, once for the ceiling
+  // sharing its cells, and the blocks are far larger than what is kept of them).
   ids_.resize(indexed);
   points_.resize(indexed);
   block_directions_.resize(indexed);

@@ -66,8 +66,10 @@ class BlockGrid {
   std::size_t cellCount() const { return map_cell_.size(); }
   // Block ids in the map's own cell order (the order its scans created the cells), each
   // cell bottom to top: eRMSM draws its seeds from a list in this order, so its random
-  // draws do not depend on how the grid numbers the blocks.
-  std::vector<std::uint32_t> idsInMapOrder() const;
+  // draws do not depend on how the grid numbers the blocks. With `keep` (a flag per
+  // block id), only the flagged ones. `threads` > 1: chunks of the map's cells on that
+  // many OpenMP threads (the order visits the grid at random, a cache miss per cell).
+  std::vector<std::uint32_t> idsInMapOrder(std::span<const std::uint8_t> keep = {}, int threads = 1) const;
 
   // Calls visit(block_id) for every block in cells within Chebyshev radius `radius` of
   // `cell`, row by row and in each cell bottom to top: ids ascending.
