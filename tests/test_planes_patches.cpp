@@ -152,7 +152,7 @@ TEST_CASE("withEdges: the edge blocks found from the scorer's index equal rings 
   CHECK(grown > 0);
 }
 
-TEST_CASE("BlockGrid: blocks numbered row by row, a Chebyshev window's blocks visited in ascending ids, map order kept") {
+TEST_CASE("BlockGrid: blocks numbered row by row, a Chebyshev window's blocks visited in ascending ids, map order kept, filtered") {
   test::PlaneSceneBuilder scene = patchScene();
   const MLMap& map = scene.map();
   const BlockGrid grid(map);
@@ -189,6 +189,15 @@ TEST_CASE("BlockGrid: blocks numbered row by row, a Chebyshev window's blocks vi
   for (std::size_t k = 1; k < in_map_order.size(); ++k) {
     CHECK(map_cell_of_block[in_map_order[k - 1]] <= map_cell_of_block[in_map_order[k]]);
   }
+  // With a flag per block, the flagged ones in the same order, on any number of threads.
+  std::vector<std::uint8_t> keep(grid.size());
+  for (std::uint32_t id = 0; id < grid.size(); ++id) keep[id] = id % 3 == 0 || blocks[id].vertical ? 1 : 0;
+  std::vector<std::uint32_t> kept;
+  for (const std::uint32_t id : in_map_order) {
+    if (keep[id] != 0) kept.push_back(id);
+  }
+  REQUIRE(kept.size() < in_map_order.size());
+  for (const int threads : {1, 2, 3}) CHECK(grid.idsInMapOrder(keep, threads) == kept);
   std::sort(in_map_order.begin(), in_map_order.end());
   for (std::uint32_t id = 0; id < grid.size(); ++id) CHECK(in_map_order[id] == id);
 }
