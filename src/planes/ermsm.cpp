@@ -42,6 +42,8 @@ double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 // 100 000 blocks use one, as the scorer's index does. There the passes take a few
 // milliseconds, and on a shared machine a parallel region can wait as long for a core.
 int patchPassThreads(const BlockGrid& grid, int threads) { return grid.size() < 100000 ? 1 : threads; }
+// A patch of fewer blocks has its labels written on one thread.
+constexpr std::int64_t kParallelPatchBlocks = 20000;
 
 // The threads an OpenMP region of `threads` (0: OpenMP's default) gets.
 int teamSize(int threads) {
@@ -233,7 +235,7 @@ bool Detector::accept(std::size_t index) {
     plane.source = accepted_;
     plane.candidates = since_acceptance_;
     const auto patch_size = static_cast<std::int64_t>(patch.blocks.size());
-#pragma omp parallel for schedule(static) num_threads(patch_threads_) if (patch_threads_ > 1 && patch_size > 20000)
+#pragma omp parallel for schedule(static) num_threads(patch_threads_) if (patch_threads_ > 1 && patch_size > kParallelPatchBlocks)
     for (std::int64_t n = 0; n < patch_size; ++n) patches_.labels[patch.blocks[static_cast<std::size_t>(n)]] = plane.id;
     taken.insert(taken.end(), patch.blocks.begin(), patch.blocks.end());
     patches_.outline_runs.push_back(std::move(split.outline_runs[k]));

@@ -42,7 +42,7 @@ struct CellRaster {
   }
 
   std::size_t slot(std::int64_t u, std::int64_t v) const { return static_cast<std::size_t>((u - min_u) * rows + (v - min_v)); }
-  bool outside(std::int64_t u, std::int64_t v) const { return cells[slot(u, v)] == kOutside; }
+  std::uint8_t state(std::int64_t u, std::int64_t v) const { return cells[slot(u, v)] & 3U; }
 
   // The empty cells the margin reaches through empty cells side by side (all of the
   // margin, from its first cell). Only the sides facing them are traced: a loop keeps
@@ -111,10 +111,10 @@ std::vector<Eigen::Vector2i> outerBoundary(const std::vector<Segment>& runs) {
   auto use = [&](const Side& side) {
     raster.cells[raster.slot(side.u, side.v)] |= static_cast<std::uint8_t>(1U << (2 + side.side));
   };
-  auto state = [&](std::int64_t u, std::int64_t v) { return raster.cells[raster.slot(u, v)] & 3U; };
   auto onBoundary = [&](const Side& side) {
     const Eigen::Vector2i other = side.across();
-    return state(side.u, side.v) == CellRaster::kOccupied && state(other.x(), other.y()) == CellRaster::kOutside;
+    return raster.state(side.u, side.v) == CellRaster::kOccupied &&
+           raster.state(other.x(), other.y()) == CellRaster::kOutside;
   };
   std::vector<Eigen::Vector2i> best;
   long best_area = 0;
