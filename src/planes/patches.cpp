@@ -1,7 +1,6 @@
 #include "mlmap/planes/patches.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <numeric>
 
