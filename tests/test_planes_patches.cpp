@@ -32,9 +32,10 @@ test::PlaneSceneBuilder patchScene() {
   return scene;
 }
 
-// Connected components the slow way: every raster cell of every block (its point, and
-// for a vertical block points along its extent a cell apart), cells within gap_cells
-// (Chebyshev) connected; patches in the order of their first block, largest first.
+// Connected components the slow way: every raster cell of every block (on a level
+// plane its map cell; else its point's, and for a vertical block those of points along
+// its extent a cell apart), cells within gap_cells (Chebyshev) connected; patches in
+// the order of their first block, largest first.
 std::vector<std::vector<std::uint32_t>> referencePatches(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
                                                          const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
                                                          int gap_cells) {
@@ -54,11 +55,12 @@ std::vector<std::vector<std::uint32_t>> referencePatches(const BlockGrid& grid, 
     if (fresh) cells.push_back(c);
     return it->second;
   };
+  const bool level = std::abs(normal.z()) > 0.96;  // within 16° of level
   for (std::size_t k = 0; k < blocks.size(); ++k) {
     const PlaneBlock& block = grid.blocks()[blocks[k]];
     const Eigen::Vector3d centre = block.point.cast<double>();
-    first_cell[k] = add(cellOf(centre));
-    if (!block.vertical) continue;
+    first_cell[k] = add(level ? std::pair<int, int>(block.cell.i, block.cell.j) : cellOf(centre));
+    if (level || !block.vertical) continue;
     const double depth = block.top - block.bottom;
     const int steps = std::max(1, static_cast<int>(std::ceil(depth / cell)));
     for (int s = 0; s <= steps; ++s) add(cellOf({centre.x(), centre.y(), block.bottom + depth * s / steps}));
@@ -204,15 +206,15 @@ TEST_CASE("BlockGrid: blocks numbered row by row, a Chebyshev window's blocks vi
 
 namespace {
 
-// The planes the split tests cut the patch scene with: a wall's plane (u level: a
-// vertical block is one run), a floor's, and a plane tilted 10° (u not level: a
-// vertical block is cells a cell apart); every block, and a sparse random one in
-// `keep_one_in` so that many small components form; gaps of 1 and 2 cells.
+// The planes the split tests cut the patch scene with: a wall's and a 30° ramp's (on
+// the plane's own raster: a vertical block is a run of cells), a floor's and one tilted
+// 10° (on the map's grid); every block, and a sparse random one in `keep_one_in` so
+// that many small components form; gaps of 1 and 2 cells.
 template <typename Check>
 void forEachSplitCase(const BlockGrid& grid, unsigned seed, unsigned keep_one_in, Check&& check) {
   std::mt19937 random(seed);
-  const std::vector<Eigen::Vector3d> normals{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(),
-                                            Eigen::Vector3d(std::sin(0.17), 0.0, std::cos(0.17))};
+  const std::vector<Eigen::Vector3d> normals{Eigen::Vector3d::UnitX(), Eigen::Vector3d(std::sin(0.52), 0.0, std::cos(0.52)),
+                                            Eigen::Vector3d::UnitZ(), Eigen::Vector3d(std::sin(0.17), 0.0, std::cos(0.17))};
   for (const Eigen::Vector3d& normal : normals) {
     for (const bool sparse : {false, true}) {
       std::vector<std::uint32_t> blocks;
@@ -361,27 +363,47 @@ TEST_CASE("outlineOf: holes, and islands inside them, leave the outer boundary a
   }
 }
 
-TEST_CASE("outlineOfRuns: the corners of a rectangle, an L and two cells touching at a corner, counter-clockwise from the lowest") {
-  // On a level plane through the origin the raster's u and v are x and y: with cells of
-  // 1 m, a corner (u, v) is the point (u, v, 0).
-  const Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+TEST_CASE("outlineOfRuns: the corners of a rectangle, an L and two cells touching at a corner, counter-clockwise about the normal") {
+  using Corners = std::vector<Eigen::Vector2i>;
+  // Cells of 1 m. On a wall facing +x through the origin the raster's u and v are y and
+  // z: a corner (u, v) is the point (0, u, v). On a level plane the raster is the map's
+  // grid, u its row (y) and v its column (x): a corner (u, v) is the point (v, u, 0),
+  // and counter-clockwise about +z runs the other way round from the same corner.
   const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
-  auto corners = [&](const std::vector<Segment>& runs) {
+  auto corners = [&](const std::vector<Segment>& runs, const Eigen::Vector3d& normal) {
     std::vector<Eigen::Vector2i> result;
     for (const Eigen::Vector3d& corner : outlineOfRuns(runs, 1.0, normal, origin)) {
-      CHECK(std::abs(corner.z()) < 1e-12);
-      result.emplace_back(static_cast<int>(std::lround(corner.x())), static_cast<int>(std::lround(corner.y())));
+      const bool level = normal.z() != 0.0;
+      CHECK(std::abs(level ? corner.z() : corner.x()) < 1e-12);
+      result.emplace_back(static_cast<int>(std::lround(corner.y())),
+                          static_cast<int>(std::lround(level ? corner.x() : corner.z())));
     }
     return result;
   };
-  using Corners = std::vector<Eigen::Vector2i>;
+  auto reversed = [](Corners loop) {
+    std::reverse(loop.begin() + 1, loop.end());
+    return loop;
+  };
+  const Eigen::Vector3d wall = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d level = Eigen::Vector3d::UnitZ();
   // Three columns of two cells.
-  CHECK(corners({{0, 0, 1}, {1, 0, 1}, {2, 0, 1}}) == Corners{{0, 0}, {3, 0}, {3, 2}, {0, 2}});
+  const Corners rectangle{{0, 0}, {3, 0}, {3, 2}, {0, 2}};
+  CHECK(corners({{0, 0, 1}, {1, 0, 1}, {2, 0, 1}}, wall) == rectangle);
   // A column of three with a row of two more along its foot.
-  CHECK(corners({{0, 0, 2}, {1, 0, 0}, {2, 0, 0}}) == Corners{{0, 0}, {3, 0}, {3, 1}, {1, 1}, {1, 3}, {0, 3}});
+  const Corners ell{{0, 0}, {3, 0}, {3, 1}, {1, 1}, {1, 3}, {0, 3}};
+  CHECK(corners({{0, 0, 2}, {1, 0, 0}, {2, 0, 0}}, wall) == ell);
   // Touching at (1, 1) only: one loop round both, through that vertex twice.
-  CHECK(corners({{0, 0, 0}, {1, 1, 1}}) == Corners{{0, 0}, {1, 0}, {1, 1}, {2, 1}, {2, 2}, {1, 2}, {1, 1}, {0, 1}});
+  const Corners touching{{0, 0}, {1, 0}, {1, 1}, {2, 1}, {2, 2}, {1, 2}, {1, 1}, {0, 1}};
+  CHECK(corners({{0, 0, 0}, {1, 1, 1}}, wall) == touching);
   // A ring of eight round a hole: the outer square only.
-  CHECK(corners({{0, 0, 2}, {1, 0, 0}, {1, 2, 2}, {2, 0, 2}}) == Corners{{0, 0}, {3, 0}, {3, 3}, {0, 3}});
-  CHECK(corners({}).empty());
+  const Corners ring{{0, 0}, {3, 0}, {3, 3}, {0, 3}};
+  CHECK(corners({{0, 0, 2}, {1, 0, 0}, {1, 2, 2}, {2, 0, 2}}, wall) == ring);
+  // The same runs on the map's grid (corners read back as (u, v) = (y, x)).
+  CHECK(corners({{0, 0, 1}, {1, 0, 1}, {2, 0, 1}}, level) == reversed(rectangle));
+  CHECK(corners({{0, 0, 2}, {1, 0, 0}, {2, 0, 0}}, level) == reversed(ell));
+  CHECK(corners({{0, 0, 0}, {1, 1, 1}}, level) == reversed(touching));
+  CHECK(corners({{0, 0, 2}, {1, 0, 0}, {1, 2, 2}, {2, 0, 2}}, level) == reversed(ring));
+  // About a normal pointing down, counter-clockwise is the raster's own turn.
+  CHECK(corners({{0, 0, 2}, {1, 0, 0}, {2, 0, 0}}, -level) == ell);
+  CHECK(corners({}, wall).empty());
 }

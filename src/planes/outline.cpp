@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "outline_runs.hpp"
+#include "raster_frame.hpp"
 
 namespace mlmap {
 namespace {
@@ -179,12 +180,10 @@ std::vector<Eigen::Vector3d> outlineOfRuns(const std::vector<Segment>& runs, dou
                                            const Eigen::Vector3d& normal, const Eigen::Vector3d& point) {
   std::vector<Eigen::Vector3d> outline;
   if (runs.empty()) return outline;
-  Eigen::Vector3d u_axis;
-  Eigen::Vector3d v_axis;
-  planeBasis(normal, u_axis, v_axis);
-  for (const Eigen::Vector2i& corner : outerBoundary(runs)) {
-    outline.push_back(point + u_axis * (corner.x() * cell_size) + v_axis * (corner.y() * cell_size));
-  }
+  const RasterFrame frame(normal, point, cell_size);
+  for (const Eigen::Vector2i& corner : outerBoundary(runs)) outline.push_back(frame.corner(corner.x(), corner.y()));
+  // From the same first corner, the other way round.
+  if (!frame.keepsTurn()) std::reverse(outline.begin() + 1, outline.end());
   return outline;
 }
 

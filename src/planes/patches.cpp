@@ -7,6 +7,7 @@
 #include "counting_sort.hpp"
 #include "fill_vector.hpp"
 #include "outline_runs.hpp"
+#include "raster_frame.hpp"
 
 namespace mlmap {
 namespace {
@@ -33,64 +34,45 @@ class DisjointSets {
   std::vector<std::size_t> parent_;
 };
 
-// The footprints of the blocks on a raster of cell_size along the plane basis from
-// `point`: raster cell (u, v) covers [u, u + 1) × [v, v + 1) cells. A horizontal block
-// covers the cell of its point, a vertical block every cell its extent crosses: with u
-// level (any plane but a near-horizontal one) that is one run of v at the u of its
-// point, else the cells of points along its extent a cell apart. Block k's segments are
-// [first_of_block[k], first_of_block[k + 1]), the one of its point first.
+// The footprints of the blocks on the plane's raster (raster_frame.hpp): raster cell
+// (u, v) covers [u, u + 1) × [v, v + 1) cells. On the map grid a block covers its map
+// cell. On the plane's basis (u level) a horizontal block covers the cell of its point,
+// a vertical block the run of v its extent crosses at the u of its point. Block k's
+// segment is segments[k].
 struct Footprints {
   FillVector<Segment> segments;
-  FillVector<std::size_t> first_of_block;
 
-  Footprints(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& u_axis,
-             const Eigen::Vector3d& v_axis, const Eigen::Vector3d& point, int threads = 1) {
-    const double cell = grid.cellSize();
-    auto cellOf = [&](const Eigen::Vector3d& p) {
-      const Eigen::Vector3d relative = p - point;
-      return Eigen::Vector2i(static_cast<std::int32_t>(std::floor(relative.dot(u_axis) / cell)),
-                             static_cast<std::int32_t>(std::floor(relative.dot(v_axis) / cell)));
-    };
-    // planeBasis makes u = z × n: level exactly, so a vertical block keeps one u.
-    const bool level_u = u_axis.z() == 0.0;
-    auto steps = [&](const PlaneBlock& block) {
-      return std::max(1, static_cast<int>(std::ceil((block.top - block.bottom) / cell)));
-    };
-    // Each block's segments in their own slots, so a floor's are placed on all threads.
+  Footprints(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const RasterFrame& frame,
+             int threads = 1)
+      : segments(blocks.size()) {
     const auto count = static_cast<std::int64_t>(blocks.size());
     const bool parallel = threads > 1 && blocks.size() >= kParallelBlocks;
-    first_of_block.resize(blocks.size() + 1);
+    if (frame.on_map_grid) {
 #pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (parallel)
-    for (std::int64_t k = 0; k < count; ++k) {
-      const PlaneBlock& block = grid.blocks()[blocks[static_cast<std::size_t>(k)]];
-      first_of_block[static_cast<std::size_t>(k) + 1] =
-          !block.vertical ? 1 : level_u ? 2 : 2 + static_cast<std::size_t>(steps(block));
+      for (std::int64_t k = 0; k < count; ++k) {
+        const CellIndex cell = grid.blocks()[blocks[static_cast<std::size_t>(k)]].cell;
+        segments[static_cast<std::size_t>(k)] = {cell.i, cell.j, cell.j};
+      }
+      return;
     }
-    first_of_block[0] = 0;
-    for (std::size_t k = 1; k <= blocks.size(); ++k) first_of_block[k] += first_of_block[k - 1];
-    segments.resize(first_of_block[blocks.size()]);
+    const double cell = grid.cellSize();
+    auto cellOf = [&](const Eigen::Vector3d& p) {
+      const Eigen::Vector3d relative = p - frame.point;
+      return Eigen::Vector2i(static_cast<std::int32_t>(std::floor(relative.dot(frame.u_axis) / cell)),
+                             static_cast<std::int32_t>(std::floor(relative.dot(frame.v_axis) / cell)));
+    };
 #pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (parallel)
     for (std::int64_t k = 0; k < count; ++k) {
-      Segment* out = segments.data() + first_of_block[static_cast<std::size_t>(k)];
       const PlaneBlock& block = grid.blocks()[blocks[static_cast<std::size_t>(k)]];
       const Eigen::Vector3d centre = block.point.cast<double>();
       const Eigen::Vector2i centre_cell = cellOf(centre);
-      *out++ = {centre_cell.x(), centre_cell.y(), centre_cell.y()};
+      Segment& segment = segments[static_cast<std::size_t>(k)];
+      segment = {centre_cell.x(), centre_cell.y(), centre_cell.y()};
       if (!block.vertical) continue;
-      const double depth = block.top - block.bottom;
-      const int step_count = steps(block);
-      auto sample = [&](int s) {
-        return cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.bottom + depth * s / step_count));
-      };
-      if (level_u) {
-        // v grows with height (v_z ≥ 0) by at most a cell per step: one run.
-        *out = {centre_cell.x(), sample(0).y(), sample(step_count).y()};
-      } else {
-        for (int s = 0; s <= step_count; ++s) {
-          const Eigen::Vector2i c = sample(s);
-          *out++ = {c.x(), c.y(), c.y()};
-        }
-      }
+      // v grows with height (v_z ≥ 0): from the bottom's cell to the top's, the centre's
+      // between them.
+      segment.v_low = cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.bottom)).y();
+      segment.v_high = cellOf(Eigen::Vector3d(centre.x(), centre.y(), block.top)).y();
     }
   }
 };
@@ -107,6 +89,31 @@ struct ColumnRuns {
 
   ColumnRuns(const FillVector<Segment>& segments, int join_gap, int fine_gap = 0, int threads = 1)
       : run_of_segment(segments.size()) {
+    auto add = [&](const Segment& segment, std::size_t n) {
+      if (runs.empty() || runs.back().u != segment.u ||
+          static_cast<std::int64_t>(segment.v_low) - runs.back().v_high > join_gap) {
+        runs.push_back(segment);
+      } else {
+        runs.back().v_high = std::max(runs.back().v_high, segment.v_high);
+      }
+      run_of_segment[n] = static_cast<std::uint32_t>(runs.size() - 1);
+      if (fine_gap <= 0) return;
+      // A new run starts a new fine run too (its gap is wider than the fine one).
+      if (fine_runs.empty() || fine_runs.back().u != segment.u ||
+          static_cast<std::int64_t>(segment.v_low) - fine_runs.back().v_high > fine_gap) {
+        fine_runs.push_back(segment);
+        parent_of_fine_run.push_back(static_cast<std::uint32_t>(runs.size() - 1));
+      } else {
+        fine_runs.back().v_high = std::max(fine_runs.back().v_high, segment.v_high);
+      }
+    };
+    // A level plane's blocks (ids ascending) on the map's grid come in raster order.
+    if (std::is_sorted(segments.begin(), segments.end(), [](const Segment& a, const Segment& b) {
+          return a.u < b.u || (a.u == b.u && a.v_low < b.v_low);
+        })) {
+      for (std::size_t n = 0; n < segments.size(); ++n) add(segments[n], n);
+      return;
+    }
     struct Numbered {
       Segment segment;
       std::uint32_t number;
@@ -117,31 +124,9 @@ struct ColumnRuns {
     for (std::int64_t n = 0; n < count; ++n) {
       order[static_cast<std::size_t>(n)] = {segments[static_cast<std::size_t>(n)], static_cast<std::uint32_t>(n)};
     }
-    // A level plane's blocks come row by row over the map's grid (ids ascending), and its
-    // raster is nearly the grid's: its footprints nearly always come in order of v_low
-    // already, and the first sort would leave them as they are.
-    const bool by_v = std::is_sorted(segments.begin(), segments.end(),
-                                     [](const Segment& a, const Segment& b) { return a.v_low < b.v_low; });
-    if (!by_v) stableSortBy(order, [](const Numbered& item) { return item.segment.v_low; }, threads);
+    stableSortBy(order, [](const Numbered& item) { return item.segment.v_low; }, threads);
     stableSortBy(order, [](const Numbered& item) { return item.segment.u; }, threads);
-    for (const auto& [segment, n] : order) {
-      if (runs.empty() || runs.back().u != segment.u ||
-          static_cast<std::int64_t>(segment.v_low) - runs.back().v_high > join_gap) {
-        runs.push_back(segment);
-      } else {
-        runs.back().v_high = std::max(runs.back().v_high, segment.v_high);
-      }
-      run_of_segment[n] = static_cast<std::uint32_t>(runs.size() - 1);
-      if (fine_gap <= 0) continue;
-      // A new run starts a new fine run too (its gap is wider than the fine one).
-      if (fine_runs.empty() || fine_runs.back().u != segment.u ||
-          static_cast<std::int64_t>(segment.v_low) - fine_runs.back().v_high > fine_gap) {
-        fine_runs.push_back(segment);
-        parent_of_fine_run.push_back(static_cast<std::uint32_t>(runs.size() - 1));
-      } else {
-        fine_runs.back().v_high = std::max(fine_runs.back().v_high, segment.v_high);
-      }
-    }
+    for (const auto& [segment, n] : order) add(segment, n);
   }
 };
 
@@ -159,10 +144,7 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
                                   int threads) {
   SplitPatches split;
   if (blocks.empty()) return split;
-  Eigen::Vector3d u_axis;
-  Eigen::Vector3d v_axis;
-  planeBasis(normal, u_axis, v_axis);
-  const Footprints footprints(grid, blocks, u_axis, v_axis, point, threads);
+  const Footprints footprints(grid, blocks, RasterFrame(normal, point, grid.cellSize()), threads);
   const FillVector<Segment>& segments = footprints.segments;
   // Cells are connected within gap_cells (Chebyshev). Not cell by cell (a wall at 2 cm
   // rasterises to over half a million cells): in each raster column u, segments less
@@ -207,7 +189,7 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
 #pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (threads > 1 && blocks.size() >= kParallelBlocks)
   for (std::int64_t k = 0; k < block_count; ++k) {
     const auto n = static_cast<std::size_t>(k);
-    root_of_block[n] = root_of_run[run_of_segment[footprints.first_of_block[n]]];
+    root_of_block[n] = root_of_run[run_of_segment[n]];
   }
   std::vector<std::size_t> patch_sizes;
   for (const std::uint32_t root : root_of_block) {
@@ -257,11 +239,9 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
 std::vector<Eigen::Vector3d> outlineOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
                                        const Eigen::Vector3d& normal, const Eigen::Vector3d& point) {
   if (blocks.empty()) return {};
-  Eigen::Vector3d u_axis;
-  Eigen::Vector3d v_axis;
-  planeBasis(normal, u_axis, v_axis);
-  return outlineOfRuns(ColumnRuns(Footprints(grid, blocks, u_axis, v_axis, point).segments, 1).runs, grid.cellSize(),
-                       normal, point);
+  return outlineOfRuns(
+      ColumnRuns(Footprints(grid, blocks, RasterFrame(normal, point, grid.cellSize())).segments, 1).runs,
+      grid.cellSize(), normal, point);
 }
 
 }  // namespace mlmap

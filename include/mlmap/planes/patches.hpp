@@ -22,8 +22,9 @@ struct Patch {
 void planeBasis(const Eigen::Vector3d& normal, Eigen::Vector3d& u, Eigen::Vector3d& v);
 
 // Blocks are rasterised on a grid of cell_size in the plane (a vertical block over
-// its whole height); occupied grid cells within `gap_cells` (Chebyshev) of each other
-// are connected. Patches are returned largest first, without outlines (outlineOf).
+// its whole height), or, for a plane within 17° of level, on the map's own grid seen
+// from above; occupied grid cells within `gap_cells` (Chebyshev) of each other are
+// connected. Patches are returned largest first, without outlines (outlineOf).
 // `threads`: OpenMP threads for large planes; the patches do not depend on them.
 std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
                                     const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
