@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 #include "counting_sort.hpp"
 #include "fill_vector.hpp"
@@ -182,29 +183,61 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
   std::vector<std::int32_t> patch_of_root(runs.size(), -1);
   std::vector<std::uint32_t> root_of_run(runs.size());
   for (std::size_t r = 0; r < runs.size(); ++r) root_of_run[r] = static_cast<std::uint32_t>(sets.find(r));
-  // Each block's component on all threads; then, in block order, the patches numbered,
-  // counted, and filled (each patch's blocks and surface sum in block order).
+  // Each block's component and surface on all threads; then, in block order, the
+  // patches numbered, counted and their surfaces summed; then each patch's blocks, in
+  // block order, placed on all threads: a slice of the blocks each, its blocks of a
+  // patch after the earlier slices' ones.
   const auto block_count = static_cast<std::int64_t>(blocks.size());
-  FillVector<std::uint32_t> root_of_block(blocks.size());
-#pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (threads > 1 && blocks.size() >= kParallelBlocks)
+  const bool parallel = threads > 1 && blocks.size() >= kParallelBlocks;
+  FillVector<std::uint32_t> patch_of_block(blocks.size());  // its root first
+  FillVector<float> surface_of(blocks.size());
+#pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (parallel)
   for (std::int64_t k = 0; k < block_count; ++k) {
     const auto n = static_cast<std::size_t>(k);
-    root_of_block[n] = root_of_run[run_of_segment[n]];
+    patch_of_block[n] = root_of_run[run_of_segment[n]];
+    surface_of[n] = grid.blocks()[blocks[n]].surface;
   }
   std::vector<std::size_t> patch_sizes;
-  for (const std::uint32_t root : root_of_block) {
+  std::vector<double> surfaces;
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const std::uint32_t root = patch_of_block[k];
     if (patch_of_root[root] < 0) {
       patch_of_root[root] = static_cast<std::int32_t>(patch_sizes.size());
       patch_sizes.push_back(0);
+      surfaces.push_back(0.0);
     }
-    ++patch_sizes[static_cast<std::size_t>(patch_of_root[root])];
+    const auto patch = static_cast<std::size_t>(patch_of_root[root]);
+    patch_of_block[k] = static_cast<std::uint32_t>(patch);
+    ++patch_sizes[patch];
+    surfaces[patch] += surface_of[k];
   }
   std::vector<Patch> patches(patch_sizes.size());
-  for (std::size_t k = 0; k < patches.size(); ++k) patches[k].blocks.reserve(patch_sizes[k]);
-  for (std::size_t k = 0; k < blocks.size(); ++k) {
-    Patch& patch = patches[static_cast<std::size_t>(patch_of_root[root_of_block[k]])];
-    patch.blocks.push_back(blocks[k]);
-    patch.surface += grid.blocks()[blocks[k]].surface;
+  for (std::size_t k = 0; k < patches.size(); ++k) {
+    patches[k].blocks.resize(patch_sizes[k]);
+    patches[k].surface = surfaces[k];
+  }
+  const int slices = parallel ? threads : 1;
+  // next[s][p]: where slice s places its next block of patch p.
+  std::vector<std::vector<std::size_t>> next(static_cast<std::size_t>(slices), std::vector<std::size_t>(patches.size(), 0));
+  auto sliceBegin = [&](int slice) { return blocks.size() * static_cast<std::size_t>(slice) / static_cast<std::size_t>(slices); };
+#pragma omp parallel num_threads(slices) if (slices > 1)
+  {
+#pragma omp for schedule(static, 1)
+    for (int slice = 0; slice < slices; ++slice) {
+      for (std::size_t k = sliceBegin(slice); k < sliceBegin(slice + 1); ++k) ++next[static_cast<std::size_t>(slice)][patch_of_block[k]];
+    }
+#pragma omp single
+    for (std::size_t p = 0; p < patches.size(); ++p) {
+      std::size_t placed = 0;
+      for (auto& slice_next : next) placed += std::exchange(slice_next[p], placed);
+    }
+#pragma omp for schedule(static, 1)
+    for (int slice = 0; slice < slices; ++slice) {
+      std::vector<std::size_t>& slice_next = next[static_cast<std::size_t>(slice)];
+      for (std::size_t k = sliceBegin(slice); k < sliceBegin(slice + 1); ++k) {
+        patches[patch_of_block[k]].blocks[slice_next[patch_of_block[k]]++] = blocks[k];
+      }
+    }
   }
   // Each patch's touching runs (at a gap of one cell the runs themselves; at none, the
   // outline's runs are not known here and stay empty).
