@@ -265,6 +265,39 @@ TEST_CASE("splitWithOutlineRuns: each patch's runs trace the outline outlineOf t
   CHECK(compared > 20);
 }
 
+TEST_CASE("splitWithOutlineRuns: a level plane of over 20 000 blocks splits the same on 1 to 3 threads") {
+  // Three floors 10 cm apart (three patches at a gap of 2 cells), thinned at random so
+  // that small pieces break off; large enough for the split's parallel passes.
+  test::PlaneSceneBuilder scene(0.02, 0.0, 3);
+  scene.floor(0.0, 0.0, 3.2, 3.0, 0.0).floor(3.3, 0.0, 4.0, 3.0, 0.0).floor(0.0, 3.1, 4.0, 3.6, 0.0);
+  const BlockGrid grid(scene.map());
+  std::mt19937 random(4);
+  std::vector<std::uint32_t> blocks;
+  for (std::uint32_t id = 0; id < grid.size(); ++id) {
+    if (random() % 7 != 0) blocks.push_back(id);
+  }
+  REQUIRE(blocks.size() > 20000);
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.0, std::sin(0.05), std::cos(0.05));
+  const Eigen::Vector3d point(1.0, 1.0, 0.0);
+  const SplitPatches one = splitWithOutlineRuns(grid, blocks, normal, point, 2, 1);
+  REQUIRE(one.patches.size() >= 3);
+  CHECK(one.patches[2].blocks.size() > 2000);  // the three floors, then the pieces
+  for (const int threads : {2, 3}) {
+    const SplitPatches many = splitWithOutlineRuns(grid, blocks, normal, point, 2, threads);
+    REQUIRE(many.patches.size() == one.patches.size());
+    for (std::size_t k = 0; k < one.patches.size(); ++k) {
+      CHECK(many.patches[k].blocks == one.patches[k].blocks);
+      CHECK(many.patches[k].surface == one.patches[k].surface);
+      REQUIRE(many.outline_runs[k].size() == one.outline_runs[k].size());
+      for (std::size_t r = 0; r < one.outline_runs[k].size(); ++r) {
+        CHECK(many.outline_runs[k][r].u == one.outline_runs[k][r].u);
+        CHECK(many.outline_runs[k][r].v_low == one.outline_runs[k][r].v_low);
+        CHECK(many.outline_runs[k][r].v_high == one.outline_runs[k][r].v_high);
+      }
+    }
+  }
+}
+
 TEST_CASE("outlineOf: the same outline whatever order the blocks are listed in") {
   test::PlaneSceneBuilder scene(0.05, 0.0, 1);
   // Two squares touching at a corner, and a ragged strip: loops meet at vertices.

@@ -78,41 +78,48 @@ struct Footprints {
   }
 };
 
-// The footprints merged per raster column: segments of a column whose rows are at most
-// `join_gap` apart join into one run (1: touching or overlapping ones). Runs are ordered
-// by u, then v, and disjoint; run_of_segment names each segment's run. With a
-// `fine_gap` under join_gap, also the runs at that gap, each inside one run (its parent).
-struct ColumnRuns {
+// Runs of segments in raster order (by u, then v_low): segments of a column whose rows
+// are at most `join_gap` apart join into one run; with a `fine_gap` under it, also the
+// runs at that gap, each inside one run (its parent). Numbered from 0.
+struct RunList {
   std::vector<Segment> runs;
-  FillVector<std::uint32_t> run_of_segment;
   std::vector<Segment> fine_runs;
   std::vector<std::uint32_t> parent_of_fine_run;
 
+  // Returns the segment's run.
+  std::uint32_t add(const Segment& segment, int join_gap, int fine_gap) {
+    if (runs.empty() || runs.back().u != segment.u ||
+        static_cast<std::int64_t>(segment.v_low) - runs.back().v_high > join_gap) {
+      runs.push_back(segment);
+    } else {
+      runs.back().v_high = std::max(runs.back().v_high, segment.v_high);
+    }
+    const auto run = static_cast<std::uint32_t>(runs.size() - 1);
+    if (fine_gap <= 0) return run;
+    // A new run starts a new fine run too (its gap is wider than the fine one).
+    if (fine_runs.empty() || fine_runs.back().u != segment.u ||
+        static_cast<std::int64_t>(segment.v_low) - fine_runs.back().v_high > fine_gap) {
+      fine_runs.push_back(segment);
+      parent_of_fine_run.push_back(run);
+    } else {
+      fine_runs.back().v_high = std::max(fine_runs.back().v_high, segment.v_high);
+    }
+    return run;
+  }
+};
+
+// The footprints merged per raster column: the RunList of all of them. Runs are
+// ordered by u, then v, and disjoint; run_of_segment names each segment's run.
+struct ColumnRuns : RunList {
+  FillVector<std::uint32_t> run_of_segment;
+
   ColumnRuns(const FillVector<Segment>& segments, int join_gap, int fine_gap = 0, int threads = 1)
       : run_of_segment(segments.size()) {
-    auto add = [&](const Segment& segment, std::size_t n) {
-      if (runs.empty() || runs.back().u != segment.u ||
-          static_cast<std::int64_t>(segment.v_low) - runs.back().v_high > join_gap) {
-        runs.push_back(segment);
-      } else {
-        runs.back().v_high = std::max(runs.back().v_high, segment.v_high);
-      }
-      run_of_segment[n] = static_cast<std::uint32_t>(runs.size() - 1);
-      if (fine_gap <= 0) return;
-      // A new run starts a new fine run too (its gap is wider than the fine one).
-      if (fine_runs.empty() || fine_runs.back().u != segment.u ||
-          static_cast<std::int64_t>(segment.v_low) - fine_runs.back().v_high > fine_gap) {
-        fine_runs.push_back(segment);
-        parent_of_fine_run.push_back(static_cast<std::uint32_t>(runs.size() - 1));
-      } else {
-        fine_runs.back().v_high = std::max(fine_runs.back().v_high, segment.v_high);
-      }
-    };
     // A level plane's blocks (ids ascending) on the map's grid come in raster order.
     if (std::is_sorted(segments.begin(), segments.end(), [](const Segment& a, const Segment& b) {
           return a.u < b.u || (a.u == b.u && a.v_low < b.v_low);
         })) {
-      for (std::size_t n = 0; n < segments.size(); ++n) add(segments[n], n);
+      fromOrdered(segments, join_gap, fine_gap, threads > 1 && segments.size() >= kParallelBlocks ? threads : 1);
       return;
     }
     struct Numbered {
@@ -127,7 +134,44 @@ struct ColumnRuns {
     }
     stableSortBy(order, [](const Numbered& item) { return item.segment.v_low; }, threads);
     stableSortBy(order, [](const Numbered& item) { return item.segment.u; }, threads);
-    for (const auto& [segment, n] : order) add(segment, n);
+    for (const auto& [segment, n] : order) run_of_segment[n] = add(segment, join_gap, fine_gap);
+  }
+
+ private:
+  // Segments in raster order, in slices that start at a new column (no run crosses
+  // one), a slice's runs on a thread each, then joined in slice order.
+  void fromOrdered(const FillVector<Segment>& segments, int join_gap, int fine_gap, int slices) {
+    std::vector<std::size_t> bounds(static_cast<std::size_t>(slices) + 1, segments.size());
+    bounds[0] = 0;
+    for (std::size_t s = 1; s < bounds.size() - 1; ++s) {
+      std::size_t at = std::max(bounds[s - 1], segments.size() * s / static_cast<std::size_t>(slices));
+      while (at > 0 && at < segments.size() && segments[at].u == segments[at - 1].u) ++at;
+      bounds[s] = at;
+    }
+    std::vector<RunList> parts(static_cast<std::size_t>(slices));
+#pragma omp parallel for schedule(static, 1) num_threads(slices) if (slices > 1)
+    for (int s = 0; s < slices; ++s) {
+      const auto slice = static_cast<std::size_t>(s);
+      for (std::size_t n = bounds[slice]; n < bounds[slice + 1]; ++n) {
+        run_of_segment[n] = parts[slice].add(segments[n], join_gap, fine_gap);
+      }
+    }
+    if (slices == 1) {
+      static_cast<RunList&>(*this) = std::move(parts[0]);
+      return;
+    }
+    std::vector<std::uint32_t> first_run(parts.size(), 0);
+    for (std::size_t s = 0; s < parts.size(); ++s) {
+      first_run[s] = static_cast<std::uint32_t>(runs.size());
+      runs.insert(runs.end(), parts[s].runs.begin(), parts[s].runs.end());
+      fine_runs.insert(fine_runs.end(), parts[s].fine_runs.begin(), parts[s].fine_runs.end());
+      for (const std::uint32_t parent : parts[s].parent_of_fine_run) parent_of_fine_run.push_back(first_run[s] + parent);
+    }
+#pragma omp parallel for schedule(static, 1) num_threads(slices)
+    for (int s = 0; s < slices; ++s) {
+      const auto slice = static_cast<std::size_t>(s);
+      for (std::size_t n = bounds[slice]; n < bounds[slice + 1]; ++n) run_of_segment[n] += first_run[slice];
+    }
   }
 };
 
