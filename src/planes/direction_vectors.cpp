@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "smallest_axis.hpp"
 
@@ -13,58 +14,116 @@
 namespace mlmap {
 namespace {
 
-// The moment sums run over a cell's neighbours once per block of the cell, and which
-// neighbours count depends on the block (its height): a branch per neighbour mispredicts
-// on every table edge. Instead each neighbour's terms sit in four-float lanes (GCC/Clang
-// vector extensions, SSE2 or NEON without -march), masked to zero when it does not count,
-// and added lane by lane. Each sum still adds the same terms in the same order as a
-// scalar loop (a masked term adds +0.0F), so the sums are bit-identical to it.
+// The moment sums of a block run over its neighbours, and which neighbours count
+// depends on the block (its height): a branch per neighbour would mispredict on every
+// table edge. Instead the neighbours sit four to a vector (GCC/Clang vector extensions,
+// SSE2 or NEON without -march), field by field, and each block's sums take four at a
+// time, masked to zero where a neighbour does not count.
 using Lanes = float __attribute__((vector_size(16)));
 using LaneMask = std::int32_t __attribute__((vector_size(16)));
 
-Lanes keepIf(bool keep, Lanes terms) {
-  const LaneMask mask = LaneMask{} - static_cast<std::int32_t>(keep);
-  return reinterpret_cast<Lanes>(reinterpret_cast<LaneMask>(terms) & mask);
-}
+Lanes keepIf(LaneMask keep, Lanes terms) { return reinterpret_cast<Lanes>(reinterpret_cast<LaneMask>(terms) & keep); }
 
-// A neighbour as the blocks of one cell see it: offsets from the cell's centre, with the
-// terms of its moments that do not depend on the block.
-struct alignas(16) Neighbour {
-  Lanes plane;   // 1, dx, dy, dx²
-  Lanes cross;   // dx·dy, dy², 0, 0
-  Lanes offset;  // 1, dx, dy, z (its point's height); horizontal neighbours only
-  float top;
-  float bottom;
+float sumOf(Lanes lanes) { return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]); }
+
+// The neighbourhood of a cell is 2r + 1 columns of 2r + 1 cells; the next cell of its
+// row shares all but one column with it. So the blocks are gathered a column at a time
+// and kept while the window slides along the row, and the sums are taken column by
+// column: within a column a block's offset across rows, dy, is a small integer (cell
+// units), and the column's own offset dx enters when its sums are added. A column's
+// blocks, four to a vector, the last vector padded with blocks that never count:
+struct Column {
+  std::int64_t j = std::numeric_limits<std::int64_t>::min();  // the grid column it holds
+  std::vector<Lanes> level_dy, level_top, level_z;            // horizontal blocks
+  std::vector<Lanes> vertical_dy, vertical_top, vertical_bottom;
+  std::size_t levels = 0;
+  std::size_t verticals = 0;
+
+  void clear(std::int64_t column) {
+    j = column;
+    levels = verticals = 0;
+    for (std::vector<Lanes>* lanes : {&level_dy, &level_top, &level_z, &vertical_dy, &vertical_top, &vertical_bottom}) {
+      lanes->clear();
+    }
+  }
+  void add(const PlaneBlock& block, float dy) {
+    const float infinity = std::numeric_limits<float>::infinity();
+    if (block.vertical) {
+      if (verticals % 4 == 0) {
+        vertical_dy.push_back(Lanes{});
+        vertical_top.push_back(Lanes{} - infinity);  // overlaps nothing
+        vertical_bottom.push_back(Lanes{} + infinity);
+      }
+      const std::size_t lane = verticals++ % 4;
+      vertical_dy.back()[lane] = dy;
+      vertical_top.back()[lane] = block.top;
+      vertical_bottom.back()[lane] = block.bottom;
+    } else {
+      if (levels % 4 == 0) {
+        level_dy.push_back(Lanes{});
+        level_top.push_back(Lanes{} + infinity);  // at no height near a block's
+        level_z.push_back(Lanes{});
+      }
+      const std::size_t lane = levels++ % 4;
+      level_dy.back()[lane] = dy;
+      level_top.back()[lane] = block.top;
+      level_z.back()[lane] = block.point.z();
+    }
+  }
 };
 
-Neighbour neighbourAt(const PlaneBlock& block, const Eigen::Vector3f& centre) {
-  const float dx = block.point.x() - centre.x();
-  const float dy = block.point.y() - centre.y();
-  return {Lanes{1.0F, dx, dy, dx * dx}, Lanes{dx * dy, dy * dy, 0.0F, 0.0F}, Lanes{1.0F, dx, dy, block.point.z()},
-          block.top, block.bottom};
-}
+// A block's sums over its kept neighbours: in cell units across, metres up relative to
+// its height. Each is four partial sums, added up at the end.
+struct Moments {
+  Lanes n{}, x{}, y{}, xx{}, xy{}, yy{};
+  Lanes z{}, xz{}, yz{}, zz{};
 
-// Blocks of one cell share their neighbourhood: it is gathered once per cell, each
-// class in its own list, and the sums are kept in float relative to the block (offsets
-// of a few cells, heights of a few centimetres), then solved in double.
-Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const std::vector<Neighbour>& horizontal,
-                                    float height_tolerance, double min_spread) {
-  Lanes plane{}, cross{}, height{};  // n, Σx, Σy, Σx² | Σxy, Σy² | Σz, Σxz, Σyz, Σz²
-  const float self_z = self.point.z();
-  for (const Neighbour& other : horizontal) {
-    const bool keep = std::abs(other.top - self.top) < height_tolerance;
-    const float z = other.offset[3] - self_z;
-    Lanes terms = other.offset;
-    terms[3] = z;
-    plane += keepIf(keep, other.plane);
-    cross += keepIf(keep, other.cross);
-    height += keepIf(keep, terms * z);  // z, dx·z, dy·z, z²
+  // One column's kept neighbours: their count and their dy's sums (n, Σdy, Σdy²), and
+  // the height sums (Σz, Σdy·z, Σz²), placed by the column's dx.
+  void addColumn(float dx, Lanes count, Lanes dy, Lanes dy2, Lanes height, Lanes dy_height, Lanes height2) {
+    n += count;
+    x += count * dx;
+    xx += count * (dx * dx);
+    y += dy;
+    xy += dy * dx;
+    yy += dy2;
+    z += height;
+    xz += height * dx;
+    yz += dy_height;
+    zz += height2;
   }
-  const float n = plane[0];
-  if (n < 3.0F) return Eigen::Vector3f::Zero();
-  const Eigen::Vector3d mean = Eigen::Vector3d(plane[1], plane[2], height[0]) / n;
+};
+
+Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const Column* const* window, int radius,
+                                    float height_tolerance, double cell, double min_spread) {
+  Moments sums;
+  const Lanes ones = Lanes{} + 1.0F;
+  for (int c = 0; c <= 2 * radius; ++c) {
+    const Column& column = *window[c];
+    Lanes count{}, dy{}, dy2{}, height{}, dy_height{}, height2{};
+    for (std::size_t q = 0; q < column.level_top.size(); ++q) {
+      const Lanes rise = column.level_top[q] - self.top;
+      const LaneMask keep = (rise < height_tolerance) & (rise > -height_tolerance);
+      const Lanes kept_dy = keepIf(keep, column.level_dy[q]);
+      const Lanes kept_z = keepIf(keep, column.level_z[q] - self.point.z());
+      count += keepIf(keep, ones);
+      dy += kept_dy;
+      dy2 += kept_dy * column.level_dy[q];
+      height += kept_z;
+      dy_height += kept_z * column.level_dy[q];
+      height2 += kept_z * kept_z;
+    }
+    sums.addColumn(static_cast<float>(c - radius), count, dy, dy2, height, dy_height, height2);
+  }
+  const double n = sumOf(sums.n);
+  if (n < 3.0) return Eigen::Vector3f::Zero();
+  const double area = cell * cell;
+  const Eigen::Vector3d mean = Eigen::Vector3d(sumOf(sums.x) * cell, sumOf(sums.y) * cell, sumOf(sums.z)) / n;
+  const double xy = sumOf(sums.xy) * area;
+  const double xz = sumOf(sums.xz) * cell;
+  const double yz = sumOf(sums.yz) * cell;
   Eigen::Matrix3d covariance;
-  covariance << plane[3], cross[0], height[1], cross[0], cross[1], height[2], height[1], height[2], height[3];
+  covariance << sumOf(sums.xx) * area, xy, xz, xy, sumOf(sums.yy) * area, yz, xz, yz, sumOf(sums.zz);
   covariance = covariance / n - mean * mean.transpose();
   const SmallestAxis smallest = smallestAxis(covariance);
   // The neighbourhood must spread in two directions, or its normal is arbitrary.
@@ -72,19 +131,29 @@ Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const std::vector<Ne
   return orientConsistently(smallest.axis.cast<float>());
 }
 
-Eigen::Vector3f verticalDirection(const PlaneBlock& self, const std::vector<Neighbour>& vertical, double min_spread) {
-  Lanes plane{}, cross{};  // n, Σx, Σy, Σx² | Σxy, Σy²
-  for (const Neighbour& other : vertical) {
-    const bool keep = !(other.bottom > self.top || other.top < self.bottom);
-    plane += keepIf(keep, other.plane);
-    cross += keepIf(keep, other.cross);
+Eigen::Vector3f verticalDirection(const PlaneBlock& self, const Column* const* window, int radius, double cell,
+                                  double min_spread) {
+  Moments sums;
+  const Lanes ones = Lanes{} + 1.0F;
+  for (int c = 0; c <= 2 * radius; ++c) {
+    const Column& column = *window[c];
+    Lanes count{}, dy{}, dy2{};
+    for (std::size_t q = 0; q < column.vertical_top.size(); ++q) {
+      // Their extents overlap.
+      const LaneMask keep = (column.vertical_bottom[q] <= self.top) & (column.vertical_top[q] >= self.bottom);
+      const Lanes kept_dy = keepIf(keep, column.vertical_dy[q]);
+      count += keepIf(keep, ones);
+      dy += kept_dy;
+      dy2 += kept_dy * column.vertical_dy[q];
+    }
+    sums.addColumn(static_cast<float>(c - radius), count, dy, dy2, Lanes{}, Lanes{}, Lanes{});
   }
-  const float n = plane[0];
-  if (n < 2.0F) return Eigen::Vector3f::Zero();
-  const Eigen::Vector2d mean = Eigen::Vector2d(plane[1], plane[2]) / n;
+  const double n = sumOf(sums.n);
+  if (n < 2.0) return Eigen::Vector3f::Zero();
+  const Eigen::Vector2d mean = Eigen::Vector2d(sumOf(sums.x), sumOf(sums.y)) * cell / n;
   Eigen::Matrix2d covariance;
-  covariance << plane[3], cross[0], cross[0], cross[1];
-  covariance = covariance / n - mean * mean.transpose();
+  covariance << sumOf(sums.xx), sumOf(sums.xy), sumOf(sums.xy), sumOf(sums.yy);
+  covariance = covariance * (cell * cell) / n - mean * mean.transpose();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver;
   solver.computeDirect(covariance);
   if (solver.eigenvalues()(1) < min_spread) return Eigen::Vector3f::Zero();
@@ -115,31 +184,51 @@ std::vector<Eigen::Vector3f> directionVectors(const BlockGrid& grid, const Direc
   // vectors are left uninitialised by their constructor, so the pages are first touched
   // by the threads that fill them.
   std::vector<Eigen::Vector3f> directions(grid.size());
-  const auto cells = static_cast<std::int64_t>(grid.cellCount());
-  const double min_spread = 0.1 * grid.cellSize() * grid.cellSize();
+  const double cell = grid.cellSize();
+  const double min_spread = 0.1 * cell * cell;
+  const int radius = std::max(0, config.radius);
   const auto& blocks = grid.blocks();
+  // Cells are numbered row by row: each row's first cell number.
+  std::vector<std::size_t> row_first;
+  for (std::size_t n = 0; n < grid.cellCount(); ++n) {
+    if (n == 0 || blocks[grid.firstBlockOfCell(n)].cell.i != blocks[grid.firstBlockOfCell(n - 1)].cell.i) {
+      row_first.push_back(n);
+    }
+  }
+  row_first.push_back(grid.cellCount());
+  const auto rows = static_cast<std::int64_t>(row_first.size()) - 1;
 #ifdef _OPENMP
   const int threads = config.threads > 0 ? config.threads : omp_get_max_threads();
 #endif
 #pragma omp parallel num_threads(threads)
   {
-    std::vector<Neighbour> horizontal;
-    std::vector<Neighbour> vertical;
-#pragma omp for schedule(dynamic, 256)
-    for (std::int64_t cell = 0; cell < cells; ++cell) {
-      const std::uint32_t begin = grid.firstBlockOfCell(static_cast<std::size_t>(cell));
-      const std::uint32_t end = grid.firstBlockOfCell(static_cast<std::size_t>(cell) + 1);
-      if (begin == end) continue;
-      const Eigen::Vector3f& centre = blocks[begin].point;
-      horizontal.clear();
-      vertical.clear();
-      grid.forEachNeighbour(blocks[begin].cell, config.radius, [&](std::uint32_t other) {
-        const PlaneBlock& block = blocks[other];
-        (block.vertical ? vertical : horizontal).push_back(neighbourAt(block, centre));
-      });
-      for (std::uint32_t id = begin; id < end; ++id) {
-        directions[id] = blocks[id].vertical ? verticalDirection(blocks[id], vertical, min_spread)
-                                             : horizontalDirection(blocks[id], horizontal, config.height_tolerance, min_spread);
+    // The columns the window has seen, each in the slot of its column number modulo the width.
+    std::vector<Column> slots(static_cast<std::size_t>(2 * radius + 1));
+    std::vector<const Column*> window(slots.size());
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t row = 0; row < rows; ++row) {
+      for (Column& slot : slots) slot.j = std::numeric_limits<std::int64_t>::min();
+      const auto first = row_first[static_cast<std::size_t>(row)];
+      const std::int64_t i = blocks[grid.firstBlockOfCell(first)].cell.i;
+      for (std::size_t n = first; n < row_first[static_cast<std::size_t>(row) + 1]; ++n) {
+        const std::uint32_t begin = grid.firstBlockOfCell(n);
+        const std::uint32_t end = grid.firstBlockOfCell(n + 1);
+        const std::int64_t j = blocks[begin].cell.j;
+        for (std::int64_t c = j - radius; c <= j + radius; ++c) {
+          const auto width = static_cast<std::int64_t>(slots.size());
+          Column& slot = slots[static_cast<std::size_t>(((c % width) + width) % width)];
+          window[static_cast<std::size_t>(c - (j - radius))] = &slot;
+          if (slot.j == c) continue;
+          slot.clear(c);
+          grid.forEachInCells(i - radius, i + radius, c, c, [&](std::uint32_t other) {
+            slot.add(blocks[other], static_cast<float>(blocks[other].cell.i - i));
+          });
+        }
+        for (std::uint32_t id = begin; id < end; ++id) {
+          directions[id] = blocks[id].vertical
+                               ? verticalDirection(blocks[id], window.data(), radius, cell, min_spread)
+                               : horizontalDirection(blocks[id], window.data(), radius, config.height_tolerance, cell, min_spread);
+        }
       }
     }
   }

@@ -87,6 +87,8 @@ class BlockGrid {
     const std::int64_t row_end = std::min<std::int64_t>(i_high - min_i_, rows_ - 1);
     const std::int64_t column_begin = std::max<std::int64_t>(j_low - min_j_, 0);
     const std::int64_t column_end = std::min<std::int64_t>(j_high - min_j_, columns_ - 1);
+    // Columns wholly beside the grid: its rows' entries there belong to other rows.
+    if (column_begin > column_end) return;
     for (std::int64_t row = row_begin; row <= row_end; ++row) {
       // The row's cells in the window hold one run of consecutive ids.
       const std::uint32_t* line = first_id_from_.data() + row * columns_;
