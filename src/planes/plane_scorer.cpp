@@ -282,56 +282,81 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
     surfaces_[n] = block.surface;
     half_depths_[n] = block.vertical ? 0.5F * (block.top - block.bottom) : 0.0F;
   }
-  // Every node's cone and box, from its blocks.
-  auto describe = [&](Node& node, const Frame& frame, std::uint32_t begin, std::uint32_t end) {
-    Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+  // Every node's cone and box: a tile's from its blocks (on all threads, its sums after
+  // it, its blocks still in cache); a layer's from its tiles and a bin's from its
+  // layers, a pass over the blocks each fewer. A box is kept in its bin's frame until
+  // the parents have theirs (the union of the children's, the same as from the blocks);
+  // a parent's cone holds its children's cones, so every member direction.
+  struct Extent {
     Eigen::Vector3f low = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
-    Eigen::Vector3f high = -low;
-    for (std::uint32_t k = begin; k < end; ++k) {
-      const Eigen::Vector3f& d = block_directions_[k];
-      mean += d.dot(frame.a) < 0.0F ? Eigen::Vector3f(-d) : d;
-      const Eigen::Vector3f q(frame.a.dot(points_[k]), frame.u.dot(points_[k]), frame.v.dot(points_[k]));
-      low = low.cwiseMin(q);
-      high = high.cwiseMax(q);
-    }
-    node.axis = mean.normalized();
-    node.cos_radius = 1.0F;
-    for (std::uint32_t k = begin; k < end; ++k) {
-      node.cos_radius = std::min(node.cos_radius, std::abs(node.axis.dot(block_directions_[k])));
-    }
-    const Eigen::Vector3f centre = 0.5F * (low + high);
+    Eigen::Vector3f high = Eigen::Vector3f::Constant(-std::numeric_limits<float>::max());
+    Eigen::Vector3f direction_sum = Eigen::Vector3f::Zero();  // turned towards the frame's axis
+  };
+  auto place = [&](Node& node, const Frame& frame, const Extent& extent) {
+    node.axis = extent.direction_sum.normalized();
+    const Eigen::Vector3f centre = 0.5F * (extent.low + extent.high);
     node.centre = frame.a * centre.x() + frame.u * centre.y() + frame.v * centre.z();
     // A little slack for the float rounding of the frame change.
-    node.half_extent = 0.5F * (high - low) + Eigen::Vector3f::Constant(1e-5F);
+    node.half_extent = 0.5F * (extent.high - extent.low) + Eigen::Vector3f::Constant(1e-5F);
   };
-  // Each node on its own, so on all threads, in one parallel region: the bins first
-  // (the polar one holds the floors and ceilings, most blocks of a building), the
-  // layers and tiles shared out while a thread goes through it. A tile's sums follow
-  // its description, its blocks still in cache.
-  const auto bin_count_signed = static_cast<std::int64_t>(bins);
+  auto fromBlocks = [&](Node& node, const Frame& frame) {
+    Extent extent;
+    for (std::uint32_t k = node.begin; k < node.end; ++k) {
+      const Eigen::Vector3f& d = block_directions_[k];
+      extent.direction_sum += d.dot(frame.a) < 0.0F ? Eigen::Vector3f(-d) : d;
+      const Eigen::Vector3f q(frame.a.dot(points_[k]), frame.u.dot(points_[k]), frame.v.dot(points_[k]));
+      extent.low = extent.low.cwiseMin(q);
+      extent.high = extent.high.cwiseMax(q);
+    }
+    place(node, frame, extent);
+    node.cos_radius = 1.0F;
+    for (std::uint32_t k = node.begin; k < node.end; ++k) {
+      node.cos_radius = std::min(node.cos_radius, std::abs(node.axis.dot(block_directions_[k])));
+    }
+    return extent;
+  };
+  auto fromChildren = [&](Node& node, const Frame& frame, const std::vector<Node>& children,
+                          const std::vector<Extent>& extents) {
+    Extent extent;
+    for (std::uint32_t c = node.begin; c < node.end; ++c) {
+      extent.low = extent.low.cwiseMin(extents[c].low);
+      extent.high = extent.high.cwiseMax(extents[c].high);
+      extent.direction_sum += extents[c].direction_sum;
+    }
+    place(node, frame, extent);
+    // A child's directions lie within its radius of its axis: within the angle from
+    // this axis to that one plus the radius. Cosines of sums, a little less for rounding.
+    node.cos_radius = 1.0F;
+    for (std::uint32_t c = node.begin; c < node.end; ++c) {
+      const float cos_apart = std::min(1.0F, std::abs(node.axis.dot(children[c].axis)));
+      const float sin_apart = std::sqrt(std::max(0.0F, 1.0F - cos_apart * cos_apart));
+      const float cos_child = children[c].cos_radius;
+      const float sin_child = std::sqrt(std::max(0.0F, 1.0F - cos_child * cos_child));
+      node.cos_radius = std::min(node.cos_radius, cos_apart * cos_child - sin_apart * sin_child - 1e-6F);
+    }
+    node.cos_radius = std::max(0.0F, node.cos_radius);
+    return extent;
+  };
   const auto layer_count_signed = static_cast<std::int64_t>(layers_.size());
   const auto tile_count_signed = static_cast<std::int64_t>(tiles_.size());
+  std::vector<Extent> tile_extents(tiles_.size());
+  std::vector<Extent> layer_extents(layers_.size());
 #pragma omp parallel num_threads(team) if (team > 1)
   {
-#pragma omp for schedule(dynamic, 1) nowait
-    for (std::int64_t b = 0; b < bin_count_signed; ++b) {
-      Node& bin = bins_[static_cast<std::size_t>(b)];
-      if (bin.begin == bin.end) continue;
-      describe(bin, frames_[static_cast<std::size_t>(b)], tiles_[layers_[bin.begin].begin].begin,
-               tiles_[layers_[bin.end - 1].end - 1].end);
-    }
-#pragma omp for schedule(dynamic, 16) nowait
-    for (std::int64_t l = 0; l < layer_count_signed; ++l) {
-      Node& layer = layers_[static_cast<std::size_t>(l)];
-      describe(layer, frames_[bin_of_layer_[static_cast<std::size_t>(l)]], tiles_[layer.begin].begin,
-               tiles_[layer.end - 1].end);
-    }
 #pragma omp for schedule(dynamic, 64)
     for (std::int64_t t = 0; t < tile_count_signed; ++t) {
-      Node& tile = tiles_[static_cast<std::size_t>(t)];
-      describe(tile, frames_[bin_of_layer_[layer_of_tile_[static_cast<std::size_t>(t)]]], tile.begin, tile.end);
-      sumTile(tile);
+      const auto tile = static_cast<std::size_t>(t);
+      tile_extents[tile] = fromBlocks(tiles_[tile], frames_[bin_of_layer_[layer_of_tile_[tile]]]);
+      sumTile(tiles_[tile]);
     }
+#pragma omp for schedule(dynamic, 16)
+    for (std::int64_t l = 0; l < layer_count_signed; ++l) {
+      const auto layer = static_cast<std::size_t>(l);
+      layer_extents[layer] = fromChildren(layers_[layer], frames_[bin_of_layer_[layer]], tiles_, tile_extents);
+    }
+  }
+  for (std::size_t b = 0; b < bins; ++b) {
+    if (bins_[b].begin != bins_[b].end) fromChildren(bins_[b], frames_[b], layers_, layer_extents);
   }
   std::vector<std::uint32_t> all_tiles(tiles_.size());
   for (std::uint32_t t = 0; t < tiles_.size(); ++t) all_tiles[t] = t;
