@@ -18,7 +18,7 @@ constexpr std::size_t kChunk = 8192;
 // The sums of add(sums, n) over n < count, taken chunk by chunk and the chunks'
 // sums combined in order: the same result at any thread count.
 template <typename Sums, typename Add, typename Combine>
-Sums sumInChunks(std::size_t count, int threads, Add add, Combine combine) {
+Sums sumInChunks(std::size_t count, [[maybe_unused]] int threads, Add add, Combine combine) {
   const std::size_t chunks = (count + kChunk - 1) / kChunk;
   std::vector<Sums> partial(chunks);
   const auto chunk_count = static_cast<std::int64_t>(chunks);

@@ -47,7 +47,7 @@ struct Footprints {
              int threads = 1)
       : segments(blocks.size()) {
     const auto count = static_cast<std::int64_t>(blocks.size());
-    const bool parallel = threads > 1 && blocks.size() >= kParallelBlocks;
+    [[maybe_unused]] const bool parallel = threads > 1 && blocks.size() >= kParallelBlocks;
     if (frame.on_map_grid) {
 #pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (parallel)
       for (std::int64_t k = 0; k < count; ++k) {
