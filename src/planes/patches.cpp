@@ -179,7 +179,8 @@ struct ColumnRuns : RunList {
 
 void planeBasis(const Eigen::Vector3d& normal, Eigen::Vector3d& u, Eigen::Vector3d& v) {
   u = Eigen::Vector3d::UnitZ().cross(normal);
-  if (u.norm() < 0.3) u = normal.cross(Eigen::Vector3d::UnitX()).cross(normal);
+  // A level plane's (RasterFrame's rule): z × n too short to be a basis.
+  if (u.norm() < RasterFrame::kLevelSine) u = normal.cross(Eigen::Vector3d::UnitX()).cross(normal);
   u.normalize();
   v = normal.cross(u).normalized();
 }
