@@ -7,6 +7,39 @@
 
 namespace mlmap {
 
+// The counting sort's placement: item n of `count`, whose bucket is bucket(n) in
+// [0, buckets), goes to place(n, position), its position in the buckets laid end to end,
+// the items of a bucket in their order. With `slices` > 1 the items are counted and
+// placed in as many contiguous slices on OpenMP threads at once: a bucket's items from
+// an earlier slice go first, so the positions are the same.
+template <typename Bucket, typename Place>
+void placeStably(std::size_t count, std::size_t buckets, Bucket bucket, Place place, int slices = 1) {
+  slices = std::max(slices, 1);
+  // next[slice × buckets + b]: where the slice's next item of bucket b goes.
+  std::vector<std::uint32_t> next(static_cast<std::size_t>(slices) * buckets, 0);
+  const auto total = static_cast<std::int64_t>(count);
+  auto sliceBegin = [&](int slice) { return static_cast<std::size_t>(total * slice / slices); };
+#pragma omp parallel for schedule(static, 1) num_threads(slices) if (slices > 1)
+  for (int slice = 0; slice < slices; ++slice) {
+    std::uint32_t* counts = next.data() + static_cast<std::size_t>(slice) * buckets;
+    for (std::size_t n = sliceBegin(slice); n < sliceBegin(slice + 1); ++n) ++counts[bucket(n)];
+  }
+  std::uint32_t placed = 0;
+  for (std::size_t b = 0; b < buckets; ++b) {
+    for (int slice = 0; slice < slices; ++slice) {
+      std::uint32_t& slot = next[static_cast<std::size_t>(slice) * buckets + b];
+      const std::uint32_t members = slot;
+      slot = placed;
+      placed += members;
+    }
+  }
+#pragma omp parallel for schedule(static, 1) num_threads(slices) if (slices > 1)
+  for (int slice = 0; slice < slices; ++slice) {
+    std::uint32_t* positions = next.data() + static_cast<std::size_t>(slice) * buckets;
+    for (std::size_t n = sliceBegin(slice); n < sliceBegin(slice + 1); ++n) place(n, positions[bucket(n)]++);
+  }
+}
+
 // Stably reorders the items by key(item), an integer: a counting sort over the keys'
 // range, or a stable comparison sort when that range is far wider than the list (a map
 // kilometres long). Sorting by the least significant key first and the most significant
@@ -34,35 +67,11 @@ void stableSortBy(std::vector<Item, Allocator>& items, Key key, int threads = 1)
     std::stable_sort(items.begin(), items.end(), [&](const Item& a, const Item& b) { return key(a) < key(b); });
     return;
   }
-  // next[slice × range + key]: where the slice's next item of that key goes.
-  std::vector<std::uint32_t> next(static_cast<std::size_t>(slices) * range, 0);
-  auto sliceBegin = [&](int slice) { return count * slice / slices; };
-#pragma omp parallel for schedule(static, 1) num_threads(slices) if (slices > 1)
-  for (int slice = 0; slice < slices; ++slice) {
-    std::uint32_t* counts = next.data() + static_cast<std::size_t>(slice) * range;
-    for (std::int64_t n = sliceBegin(slice); n < sliceBegin(slice + 1); ++n) {
-      ++counts[static_cast<std::size_t>(key(items[static_cast<std::size_t>(n)]) - low)];
-    }
-  }
-  std::uint32_t placed = 0;
-  for (std::size_t k = 0; k < range; ++k) {
-    for (int slice = 0; slice < slices; ++slice) {
-      std::uint32_t& slot = next[static_cast<std::size_t>(slice) * range + k];
-      const std::uint32_t members = slot;
-      slot = placed;
-      placed += members;
-    }
-  }
   // Every slot is written below (with a FillVector's allocator, not zeroed first).
   std::vector<Item, Allocator> sorted(items.size());
-#pragma omp parallel for schedule(static, 1) num_threads(slices) if (slices > 1)
-  for (int slice = 0; slice < slices; ++slice) {
-    std::uint32_t* positions = next.data() + static_cast<std::size_t>(slice) * range;
-    for (std::int64_t n = sliceBegin(slice); n < sliceBegin(slice + 1); ++n) {
-      const Item& item = items[static_cast<std::size_t>(n)];
-      sorted[positions[static_cast<std::size_t>(key(item) - low)]++] = item;
-    }
-  }
+  placeStably(
+      items.size(), range, [&](std::size_t n) { return static_cast<std::size_t>(key(items[n]) - low); },
+      [&](std::size_t n, std::uint32_t position) { sorted[position] = items[n]; }, slices);
   items = std::move(sorted);
 }
 

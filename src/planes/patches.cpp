@@ -230,8 +230,7 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
   for (std::size_t r = 0; r < runs.size(); ++r) root_of_run[r] = static_cast<std::uint32_t>(sets.find(r));
   // Each block's component and surface on all threads; then, in block order, the
   // patches numbered, counted and their surfaces summed; then each patch's blocks, in
-  // block order, placed on all threads: a slice of the blocks each, its blocks of a
-  // patch after the earlier slices' ones.
+  // block order, placed on all threads (the counting sort's placement).
   const auto block_count = static_cast<std::int64_t>(blocks.size());
   const bool parallel = threads > 1 && blocks.size() >= kParallelBlocks;
   FillVector<std::uint32_t> patch_of_block(blocks.size());  // its root first
@@ -257,33 +256,19 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
     surfaces[patch] += surface_of[k];
   }
   std::vector<Patch> patches(patch_sizes.size());
+  std::vector<std::size_t> first_position(patches.size(), 0);  // of each patch, its blocks laid end to end
   for (std::size_t k = 0; k < patches.size(); ++k) {
     patches[k].blocks.resize(patch_sizes[k]);
     patches[k].surface = surfaces[k];
+    if (k + 1 < patches.size()) first_position[k + 1] = first_position[k] + patch_sizes[k];
   }
-  const int slices = parallel ? threads : 1;
-  // next[s][p]: where slice s places its next block of patch p.
-  std::vector<std::vector<std::size_t>> next(static_cast<std::size_t>(slices), std::vector<std::size_t>(patches.size(), 0));
-  auto sliceBegin = [&](int slice) { return blocks.size() * static_cast<std::size_t>(slice) / static_cast<std::size_t>(slices); };
-#pragma omp parallel num_threads(slices) if (slices > 1)
-  {
-#pragma omp for schedule(static, 1)
-    for (int slice = 0; slice < slices; ++slice) {
-      for (std::size_t k = sliceBegin(slice); k < sliceBegin(slice + 1); ++k) ++next[static_cast<std::size_t>(slice)][patch_of_block[k]];
-    }
-#pragma omp single
-    for (std::size_t p = 0; p < patches.size(); ++p) {
-      std::size_t placed = 0;
-      for (auto& slice_next : next) placed += std::exchange(slice_next[p], placed);
-    }
-#pragma omp for schedule(static, 1)
-    for (int slice = 0; slice < slices; ++slice) {
-      std::vector<std::size_t>& slice_next = next[static_cast<std::size_t>(slice)];
-      for (std::size_t k = sliceBegin(slice); k < sliceBegin(slice + 1); ++k) {
-        patches[patch_of_block[k]].blocks[slice_next[patch_of_block[k]]++] = blocks[k];
-      }
-    }
-  }
+  placeStably(
+      blocks.size(), patches.size(), [&](std::size_t k) { return static_cast<std::size_t>(patch_of_block[k]); },
+      [&](std::size_t k, std::uint32_t position) {
+        const std::uint32_t patch = patch_of_block[k];
+        patches[patch].blocks[position - first_position[patch]] = blocks[k];
+      },
+      parallel ? threads : 1);
   // Each patch's touching runs (at a gap of one cell the runs themselves; at none, the
   // outline's runs are not known here and stay empty).
   std::vector<std::vector<Segment>> outline_runs(patches.size());
