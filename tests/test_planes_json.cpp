@@ -1,7 +1,9 @@
 // The planes JSON export against web/planes.schema.json, and its content.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <fstream>
+#include <sstream>
 #include <set>
 
 #include "mlmap/error.hpp"
@@ -89,6 +91,43 @@ TEST_CASE("PlanesJson: an export reads back to the same planes") {
   CHECK(back.stats.candidates == detection.stats.candidates);
   CHECK(back.config.kappa_deg == detection.config.kappa_deg);
   CHECK(back.config.seed == detection.config.seed);
+}
+
+TEST_CASE("PlanesJson: a plane per line, outline corners and centroids to the micrometre") {
+  test::PlaneSceneBuilder scene(0.05);
+  // Offsets that are not whole cells, so the corners lifted onto the planes are not
+  // round numbers before the export rounds them.
+  scene.floor(0.0, 0.0, 4.0, 3.0, 0.0123456789).wallX(0.0, 0.0, 3.0, 0.0123456789, 2.6);
+  Map map(MapConfig{0.05, 0.0, -1.0, false});
+  map.blocks() = scene.map();
+  const PlaneDetection detection = detectPlanes(map.blocks());
+  REQUIRE(detection.planes.size() >= 2);
+  const std::string text = io::planesJson(map, detection, "room.mlmap");
+  std::istringstream lines(text);
+  std::string line;
+  std::size_t plane_lines = 0;
+  const auto onMicrometres = [](double metres) {
+    return std::abs(metres * 1e6 - std::round(metres * 1e6)) < 1e-3;
+  };
+  while (std::getline(lines, line)) {
+    if (line.rfind("    {", 0) != 0) continue;
+    if (line.back() == ',') line.pop_back();
+    const nlohmann::json plane = nlohmann::json::parse(line);
+    const Plane& expected = detection.planes[plane_lines++];
+    CHECK(plane["id"] == expected.id);
+    REQUIRE(plane["outline"].size() == expected.outline.size());
+    for (std::size_t k = 0; k < expected.outline.size(); ++k) {
+      for (int axis = 0; axis < 3; ++axis) {
+        const double written = plane["outline"][k][axis].get<double>();
+        CHECK(onMicrometres(written));
+        CHECK(std::abs(written - expected.outline[k][axis]) <= 0.5e-6 + 1e-12);
+      }
+    }
+    for (int axis = 0; axis < 3; ++axis) CHECK(onMicrometres(plane["centroid"][axis].get<double>()));
+    // Normals keep every digit: a plane's offset is only as good as its normal.
+    for (int axis = 0; axis < 3; ++axis) CHECK(plane["normal"][axis].get<double>() == expected.normal[axis]);
+  }
+  CHECK(plane_lines == detection.planes.size());
 }
 
 TEST_CASE("PlanesJson: the reader refuses what is not an export, naming the element") {

@@ -14,7 +14,8 @@ namespace mlmap::io {
 
 constexpr const char* kPlanesSchema = "mlmap.planes/1";
 
-// The export as JSON text (2-space indented).
+// The export as JSON text: a member per line, a plane per line, positions (centroids,
+// outlines) rounded to the micrometre.
 std::string planesJson(const Map& map, const PlaneDetection& detection, const std::string& source_name);
 
 // Written atomically.
