@@ -385,6 +385,23 @@ void PlaneScorer::refresh(const std::vector<std::uint32_t>& tiles) {
   sumLayersAndBins(tiles);
 }
 
+namespace {
+
+// A parent's sums from its children's [begin, end), each shifted to the parent's centre.
+template <typename Node>
+void sumChildren(Node& parent, const std::vector<Node>& children) {
+  parent.untaken = 0;
+  parent.surface = 0.0;
+  parent.pca = PcaSums{};
+  for (std::uint32_t c = parent.begin; c < parent.end; ++c) {
+    parent.untaken += children[c].untaken;
+    parent.surface += children[c].surface;
+    parent.pca.addShifted(children[c].pca, (children[c].centre - parent.centre).template cast<double>());
+  }
+}
+
+}  // namespace
+
 // The sums of the layers and bins of the given tiles (ascending), from their tiles'.
 void PlaneScorer::sumLayersAndBins(const std::vector<std::uint32_t>& tiles) {
   std::vector<std::uint32_t> layers;
@@ -393,28 +410,10 @@ void PlaneScorer::sumLayersAndBins(const std::vector<std::uint32_t>& tiles) {
   }
   std::vector<std::uint32_t> bins;
   for (const std::uint32_t l : layers) {
-    Node& layer = layers_[l];
-    layer.untaken = 0;
-    layer.surface = 0.0;
-    layer.pca = PcaSums{};
-    for (std::uint32_t t = layer.begin; t < layer.end; ++t) {
-      layer.untaken += tiles_[t].untaken;
-      layer.surface += tiles_[t].surface;
-      layer.pca.addShifted(tiles_[t].pca, (tiles_[t].centre - layer.centre).cast<double>());
-    }
+    sumChildren(layers_[l], tiles_);
     if (bins.empty() || bins.back() != bin_of_layer_[l]) bins.push_back(bin_of_layer_[l]);
   }
-  for (const std::uint32_t b : bins) {
-    Node& bin = bins_[b];
-    bin.untaken = 0;
-    bin.surface = 0.0;
-    bin.pca = PcaSums{};
-    for (std::uint32_t l = bin.begin; l < bin.end; ++l) {
-      bin.untaken += layers_[l].untaken;
-      bin.surface += layers_[l].surface;
-      bin.pca.addShifted(layers_[l].pca, (layers_[l].centre - bin.centre).cast<double>());
-    }
-  }
+  for (const std::uint32_t b : bins) sumChildren(bins_[b], layers_);
 }
 
 PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
