@@ -22,6 +22,9 @@ constexpr int kElevationRows = 9;  // 10° each over [0°, 90°]; the top row is
 // A tile is this many cells wide: large enough that a plane's slab holds whole tiles,
 // small enough that the slab's faces cut few blocks.
 constexpr int kTileCells = 16;
+// A layer node holds at least this many blocks: in a building's clutter most slices
+// hold a block or two, and a node per slice cost more to test than its blocks.
+constexpr std::size_t kMinLayerBlocks = 64;
 // Cones closer than this to κ are decided block by block (float rounding).
 constexpr float kCosMargin = 1e-5F;
 // Maps of fewer blocks build their index on one thread.
@@ -226,13 +229,16 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   tiles_.reserve(tile_count);
   layer_of_tile_.reserve(tile_count);
   tile_of_.reserve(order.size());
+  std::size_t layer_first = 0;  // the current layer's first block
   for (std::size_t k = 0; k < order.size(); ++k) {
     const Place& place = order[k];
     const Place* previous = k == 0 ? nullptr : &order[k - 1];
     const auto bin = place.bin;
     const bool new_bin = previous == nullptr || previous->bin != bin;
-    const bool new_layer = new_bin || previous->layer != place.layer;
-    const bool new_tile = new_layer || previous->tile_u != place.tile_u || previous->tile_v != place.tile_v;
+    const bool next_slice = !new_bin && previous->layer != place.layer;
+    const bool new_layer = new_bin || (next_slice && k - layer_first >= kMinLayerBlocks);
+    const bool new_tile = new_layer || next_slice || previous->tile_u != place.tile_u || previous->tile_v != place.tile_v;
+    if (new_layer) layer_first = k;
     if (new_bin) bins_[static_cast<std::size_t>(bin)].begin = static_cast<std::uint32_t>(layers_.size());
     if (new_layer) {
       layers_.emplace_back();

@@ -4,13 +4,13 @@
 //
 // A pass over every block for every candidate costs most of the detection time on a
 // fine map, so the blocks are indexed: by the orientation of their direction vectors
-// (bins), inside a bin by their offset along the bin's axis (layers, ε/2 thick), inside
-// a layer by position (tiles, a few cells wide). Every node knows the cone of its
-// blocks' directions, the box of their points and the sums of its untaken blocks. A
-// node whose cone lies within κ of the plane's normal and whose box lies within the
-// slab |n·x + d| < ε counts whole; a node whose cone or box lies outside is skipped;
-// only the nodes the cone or the slab's faces cut are opened. The result is the score
-// of the paper's definition, block for block.
+// (bins), inside a bin by their offset along the bin's axis (layers: slices ε/2 thick,
+// consecutive sparse slices joined), inside a slice by position (tiles, a few cells
+// wide). Every node knows the cone of its blocks' directions, the box of their points
+// and the sums of its untaken blocks. A node whose cone lies within κ of the plane's
+// normal and whose box lies within the slab |n·x + d| < ε counts whole; a node whose
+// cone or box lies outside is skipped; only the nodes the cone or the slab's faces cut
+// are opened. The result is the score of the paper's definition, block for block.
 #pragma once
 
 #include <Eigen/Core>
