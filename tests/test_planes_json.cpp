@@ -17,6 +17,14 @@ using namespace mlmap;
 
 namespace {
 
+// A floor and a wall standing on it, at `height`, on a 5 cm map, and its planes.
+PlaneDetection floorAndWall(Map& map, double height) {
+  test::PlaneSceneBuilder scene(0.05);
+  scene.floor(0.0, 0.0, 4.0, 3.0, height).wallX(0.0, 0.0, 3.0, height, 2.6);
+  map.blocks() = scene.map();
+  return detectPlanes(map.blocks());
+}
+
 test::JsonSchema planesSchema() {
   std::ifstream in(test::sourceDir() / "web" / "planes.schema.json");
   return test::JsonSchema(nlohmann::json::parse(in));
@@ -68,11 +76,8 @@ TEST_CASE("PlanesJson: a failed write leaves no file") {
 }
 
 TEST_CASE("PlanesJson: an export reads back to the same planes") {
-  test::PlaneSceneBuilder scene(0.05);
-  scene.floor(0.0, 0.0, 4.0, 3.0, 0.0).wallX(0.0, 0.0, 3.0, 0.0, 2.6);
   Map map(MapConfig{0.05, 0.0, -1.0, false});
-  map.blocks() = scene.map();
-  const PlaneDetection detection = detectPlanes(map.blocks());
+  const PlaneDetection detection = floorAndWall(map, 0.0);
   REQUIRE(detection.planes.size() >= 2);
   const PlaneDetection back = io::parsePlanesJson(io::planesJson(map, detection, "room.mlmap"), "room.json");
   REQUIRE(back.planes.size() == detection.planes.size());
@@ -94,13 +99,10 @@ TEST_CASE("PlanesJson: an export reads back to the same planes") {
 }
 
 TEST_CASE("PlanesJson: a plane per line, outline corners and centroids to the micrometre") {
-  test::PlaneSceneBuilder scene(0.05);
-  // Offsets that are not whole cells, so the corners lifted onto the planes are not
-  // round numbers before the export rounds them.
-  scene.floor(0.0, 0.0, 4.0, 3.0, 0.0123456789).wallX(0.0, 0.0, 3.0, 0.0123456789, 2.6);
   Map map(MapConfig{0.05, 0.0, -1.0, false});
-  map.blocks() = scene.map();
-  const PlaneDetection detection = detectPlanes(map.blocks());
+  // A height that is not whole cells, so the corners lifted onto the planes are not
+  // round numbers before the export rounds them.
+  const PlaneDetection detection = floorAndWall(map, 0.0123456789);
   REQUIRE(detection.planes.size() >= 2);
   const std::string text = io::planesJson(map, detection, "room.mlmap");
   std::istringstream lines(text);
