@@ -130,6 +130,14 @@ TEST_CASE("PlanesJson: a plane per line, outline corners and centroids to the mi
     for (int axis = 0; axis < 3; ++axis) CHECK(plane["normal"][axis].get<double>() == expected.normal[axis]);
   }
   CHECK(plane_lines == detection.planes.size());
+  // The measured noise is a float: written as one (at most 9 significant digits), it
+  // reads back to the same float.
+  const nlohmann::json parameters = nlohmann::json::parse(text)["parameters"];
+  const std::string noise_text = parameters["noise"].dump();
+  CAPTURE(noise_text);
+  CHECK(noise_text.find_first_not_of("0.") != std::string::npos);
+  CHECK(noise_text.size() - noise_text.find_first_not_of("0.") <= 10);
+  CHECK(static_cast<float>(parameters["noise"].get<double>()) == static_cast<float>(detection.config.noise));
 }
 
 TEST_CASE("PlanesJson: the reader refuses what is not an export, naming the element") {

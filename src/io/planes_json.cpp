@@ -1,5 +1,6 @@
 #include "mlmap/io/planes_json.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -16,6 +17,15 @@ nlohmann::json vector3(const Eigen::Vector3d& v) { return nlohmann::json::array(
 double toMicrometre(double metres) { return std::isfinite(metres) ? std::round(metres * 1e6) / 1e6 : metres; }
 nlohmann::json position(const Eigen::Vector3d& v) {
   return nlohmann::json::array({toMicrometre(v.x()), toMicrometre(v.y()), toMicrometre(v.z())});
+}
+// Values the detection holds in single precision (ε, the measured noise) as the float
+// they are: "0.03", not the "0.029999999329447746" of that float widened to double.
+double asFloat(double value) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof(text), static_cast<float>(value)).ptr;
+  double shortest = value;
+  std::from_chars(text, end, shortest);
+  return shortest;
 }
 
 // CityJSON's names for the classes it has, for interchange.
@@ -41,7 +51,7 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
                  {"blocks", stats.blocks},
                  {"bounds", {{"min", position(stats.min)}, {"max", position(stats.max)}}}};
   json["parameters"] = {{"radius_cells", config.radius},
-                        {"epsilon", config.epsilon},
+                        {"epsilon", asFloat(config.epsilon)},
                         {"kappa_deg", config.kappa_deg},
                         {"theta_deg", config.theta_deg},
                         {"min_probability", config.min_probability},
@@ -57,7 +67,7 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
                         {"batch_size", config.batch_size},
                         {"max_refits", config.max_refits},
                         {"refit_gain", config.refit_gain},
-                        {"noise", config.noise},
+                        {"noise", asFloat(config.noise)},
                         {"stack_gap", config.stack_gap},
                         {"ladder_gap", config.ladder_gap},
                         {"ladder_blocks", config.ladder_blocks},
