@@ -67,6 +67,12 @@ TEST_CASE("CLI: planes -o keeps the planes in the map, and export writes every f
   RoomMaps rooms;
   const fs::path labelled = rooms.labelled();
   REQUIRE(mlmap::io::readMap(labelled).planes().has_value());
+  // The summary says which parameters the run used, the resolved ε and σ among them.
+  const auto printed = runCli("--quiet planes " + rooms.map.string() + " --seed 7 --kappa 20");
+  REQUIRE_MESSAGE(printed.exit_code == 0, printed.output);
+  CHECK_MESSAGE(printed.output.find("parameters: r 2 cells, ε 0.050 m, σ 0.") != std::string::npos, printed.output);
+  CHECK_MESSAGE(printed.output.find("κ 20°, θ 15°") != std::string::npos, printed.output);
+  CHECK_MESSAGE(printed.output.find("seed 7\n") != std::string::npos, printed.output);
 
   mlmap::test::writeText(rooms.dir / "page.html", "<!doctype html><title>dashboard</title>");
   const fs::path out = rooms.dir / "out";
