@@ -217,15 +217,16 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
       },
       team);
   bins_.resize(bins);
-  std::size_t layer_count = 0;
+  // Reserved whole: a tile per change of slice or tile, a layer per slice at most.
+  std::size_t slice_count = 0;
   std::size_t tile_count = 0;
   for (std::size_t k = 0; k < order.size(); ++k) {
-    const bool new_layer = k == 0 || order[k - 1].bin != order[k].bin || order[k - 1].layer != order[k].layer;
-    layer_count += new_layer ? 1 : 0;
-    tile_count += new_layer || order[k - 1].tile_u != order[k].tile_u || order[k - 1].tile_v != order[k].tile_v ? 1 : 0;
+    const bool new_slice = k == 0 || order[k - 1].bin != order[k].bin || order[k - 1].layer != order[k].layer;
+    slice_count += new_slice ? 1 : 0;
+    tile_count += new_slice || order[k - 1].tile_u != order[k].tile_u || order[k - 1].tile_v != order[k].tile_v ? 1 : 0;
   }
-  layers_.reserve(layer_count);
-  bin_of_layer_.reserve(layer_count);
+  layers_.reserve(slice_count);
+  bin_of_layer_.reserve(slice_count);
   tiles_.reserve(tile_count);
   layer_of_tile_.reserve(tile_count);
   tile_of_.reserve(order.size());
