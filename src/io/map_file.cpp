@@ -24,7 +24,10 @@ constexpr char kMagic[8] = {'\x89', 'M', 'L', 'M', 'A', 'P', '\r', '\n'};
 constexpr std::uint32_t kHasOctree = 1U;
 constexpr std::uint32_t kHasPlanes = 2U;
 constexpr std::uint32_t kOldestReadableVersion = 1;
-constexpr std::size_t kBlockBytes = 17;
+constexpr std::size_t kBlockBytesV2 = 17;
+// Version 3 adds the points' moments: count u32, mean f32 × 3, scatter f32 × 6.
+constexpr std::size_t kPointStatsBytes = 40;
+constexpr std::size_t blockBytes(std::uint32_t version) { return kBlockBytesV2 + (version >= 3 ? kPointStatsBytes : 0); }
 constexpr std::size_t kCellHeaderBytes = 10;
 
 template <typename T>
@@ -81,7 +84,7 @@ void writeMap(const std::filesystem::path& path, const Map& map) {
   const MLMap& blocks = map.blocks();
   const MapConfig& config = map.config();
   std::string out;
-  out.reserve(64 + blocks.cellCount() * kCellHeaderBytes + blocks.blockCount() * kBlockBytes);
+  out.reserve(64 + blocks.cellCount() * kCellHeaderBytes + blocks.blockCount() * blockBytes(kMapFileVersion));
   out.append(kMagic, sizeof(kMagic));
   put<std::uint32_t>(out, kMapFileVersion);
   put<std::uint32_t>(out, (map.hasOctree() ? kHasOctree : 0U) | (map.planes() ? kHasPlanes : 0U));
@@ -105,6 +108,12 @@ void writeMap(const std::filesystem::path& path, const Map& map) {
       put<float>(out, block.depth);
       put<std::int32_t>(out, block.plane);
       put<std::uint8_t>(out, static_cast<std::uint8_t>(block.kind));
+      const PointStats& points = block.points;
+      put<std::uint32_t>(out, points.count);
+      put<float>(out, points.mean_x);
+      put<float>(out, points.mean_y);
+      put<float>(out, points.mean_z);
+      for (const float value : points.scatter) put<float>(out, value);
     }
   }
   std::string octree_bytes;
@@ -170,7 +179,7 @@ Map readMap(const std::filesystem::path& path) {
   const auto block_count = in.get<std::uint64_t>("the block count");
   // Refuse counts the file cannot hold before allocating anything for them.
   if (cell_count > in.remaining() / kCellHeaderBytes ||
-      block_count > in.remaining() / kBlockBytes) {
+      block_count > in.remaining() / blockBytes(version)) {
     in.fail("the header claims " + std::to_string(cell_count) + " cells and " +
             std::to_string(block_count) + " blocks, more than the file holds");
   }
@@ -180,7 +189,7 @@ Map readMap(const std::filesystem::path& path) {
     const std::size_t cell_offset = in.offset();
     const CellIndex cell{in.get<std::int32_t>("a cell index"), in.get<std::int32_t>("a cell index")};
     const auto count = in.get<std::uint16_t>("a block count");
-    in.need(std::size_t{count} * kBlockBytes, "a cell's blocks");
+    in.need(std::size_t{count} * blockBytes(version), "a cell's blocks");
     cell_blocks.resize(count);
     for (Block& block : cell_blocks) {
       block.height = in.get<float>("a block");
@@ -190,6 +199,14 @@ Map readMap(const std::filesystem::path& path) {
       const auto kind = in.get<std::uint8_t>("a block");
       if (kind > 1) in.failAt(in.offset() - 1, "unknown block kind " + std::to_string(kind));
       block.kind = static_cast<BlockKind>(kind);
+      block.points = PointStats{};
+      if (version >= 3) {
+        block.points.count = in.get<std::uint32_t>("a block's points");
+        block.points.mean_x = in.get<float>("a block's points");
+        block.points.mean_y = in.get<float>("a block's points");
+        block.points.mean_z = in.get<float>("a block's points");
+        for (float& value : block.points.scatter) value = in.get<float>("a block's points");
+      }
     }
     blocks_seen += count;
     try {

@@ -52,7 +52,8 @@ void updateBlock(Block& block, double z, double variance) {
 
 }  // namespace
 
-int addMeasurement(Block* blocks, int count, float top, float bottom, float variance, float reach) {
+int addMeasurement(Block* blocks, int count, float top, float bottom, float variance, float reach,
+                   const PointStats& points) {
   // A block collects a measurement when it lies within cell_size of the block's
   // extent [h − d, h]. Blocks are sorted and at least cell_size apart,
   // so the collectors of [bottom, top] are adjacent in the run.
@@ -71,6 +72,7 @@ int addMeasurement(Block* blocks, int count, float top, float bottom, float vari
   const bool is_point = top == bottom;
   if (first_hit >= 0 && first_hit == last_hit && is_point) {
     updateBlock(blocks[first_hit], top, variance);
+    blocks[first_hit].points.merge(points);
     return count;
   }
   if (first_hit >= 0) {
@@ -84,6 +86,8 @@ int addMeasurement(Block* blocks, int count, float top, float bottom, float vari
     merged.height = new_top ? top : highest.height;
     merged.variance = new_top ? variance : highest.variance;
     merged.depth = merged.height - std::min(lowest.bottom(), bottom);
+    for (int k = first_hit; k <= last_hit; ++k) merged.points.merge(blocks[k].points);
+    merged.points.merge(points);
     blocks[first_hit] = merged;
     const int removed = last_hit - first_hit;
     std::copy(blocks + last_hit + 1, blocks + count, blocks + first_hit + 1);
@@ -91,8 +95,8 @@ int addMeasurement(Block* blocks, int count, float top, float bottom, float vari
   }
   // Fig. 3 case 1: nobody collects the measurement; a new block.
   std::copy_backward(blocks + insert_at, blocks + count, blocks + count + 1);
-  blocks[insert_at] = is_point ? Block{top, variance, 0.0F, 0, BlockKind::Horizontal}
-                               : Block{top, variance, top - bottom, 0, BlockKind::Vertical};
+  blocks[insert_at] = is_point ? Block{top, variance, 0.0F, 0, BlockKind::Horizontal, points}
+                               : Block{top, variance, top - bottom, 0, BlockKind::Vertical, points};
   return count + 1;
 }
 

@@ -57,15 +57,21 @@ void mergeBlocks(MLMap& base, const MLMap& other, const Eigen::Isometry3d& other
   std::sort(ordered.begin(), ordered.end());
   const Eigen::Isometry3d base_to_other = other_to_base.inverse();
   const auto height_shift = static_cast<float>(other_to_base.translation().z());
+  // Blocks only turn about z (the transform was levelled): the points' moments turn
+  // with them, and their mean is then taken from the target cell's centre.
+  const double yaw = std::atan2(other_to_base.linear()(1, 0), other_to_base.linear()(0, 0));
   for (const std::uint64_t packed : ordered) {
     const CellIndex target = unpackCell(packed);
     const Eigen::Vector2d centre = base.cellCenter(target);
     const Eigen::Vector3d source_point = base_to_other * Eigen::Vector3d(centre.x(), centre.y(), 0.0);
     const auto source = other.findCellOf(source_point.x(), source_point.y());
     if (!source) continue;
+    const Eigen::Vector2d source_centre = other.cellCenter(*source);
+    const Eigen::Vector3d moved_centre = other_to_base * Eigen::Vector3d(source_centre.x(), source_centre.y(), 0.0);
     for (Block block : other.blocks(*source)) {
       block.height += height_shift;
       block.plane = 0;
+      block.points = block.points.turned(yaw, height_shift).shifted(centre.x() - moved_centre.x(), centre.y() - moved_centre.y());
       base.insertBlock(target, block);
     }
   }

@@ -66,6 +66,17 @@ std::vector<std::uint32_t> sortedByCell(const std::vector<CellIndex>& cells) {
   return order;
 }
 
+// A block's point moments as a reader may restore them: finite, the mean's x and y
+// near the cell (a merged map's blocks may sit up to a cell beside their own), the
+// scatter's diagonal not negative beyond rounding.
+bool validStats(const PointStats& stats, double cell_size) {
+  if (stats.count == 0) return true;
+  const auto reach = static_cast<float>(cell_size);
+  bool finite = std::isfinite(stats.mean_z) && std::abs(stats.mean_x) <= reach && std::abs(stats.mean_y) <= reach;
+  for (const float value : stats.scatter) finite = finite && std::isfinite(value) && std::abs(value) < 1e12F;
+  return finite && stats.scatter[0] >= -1e-6F && stats.scatter[3] >= -1e-6F && stats.scatter[5] >= -1e-6F;
+}
+
 }  // namespace
 
 MLMap::MLMap(double cell_size) : cell_size_(cell_size), inverse_cell_size_(1.0 / cell_size) {
@@ -150,13 +161,13 @@ void MLMap::reserveCell(Cell& cell, std::size_t capacity) {
   cell.capacity = static_cast<std::uint16_t>(capacity);
 }
 
-void MLMap::insertIntoCell(std::size_t cell_number, float top, float bottom, float variance) {
+void MLMap::insertIntoCell(std::size_t cell_number, float top, float bottom, float variance, const PointStats& points) {
   Cell& cell = cells_[cell_number];
   if (cell.count == cell.capacity) {
     reserveCell(cell, std::min<std::size_t>(cell.capacity * 2U + 1U, kMaxBlocksPerCell));
   }
   const int count = addMeasurement(blocks_.data() + cell.first, cell.count, top, bottom, variance,
-                                   static_cast<float>(cell_size_));
+                                   static_cast<float>(cell_size_), points);
   block_count_ += static_cast<std::size_t>(count) - cell.count;
   cell.count = static_cast<std::uint16_t>(count);
 }
@@ -165,9 +176,13 @@ void MLMap::insert(const Point& point, double variance) {
   if (!std::isfinite(point.z()) || !(variance > 0.0) || !std::isfinite(variance)) {
     throw Error("measurement with a non-finite height or a non-positive variance");
   }
-  const std::size_t cell_number = findOrCreateCell(cellOf(point.x(), point.y()));
+  const CellIndex cell = cellOf(point.x(), point.y());
+  const std::size_t cell_number = findOrCreateCell(cell);
   const auto z = static_cast<float>(point.z());
-  insertIntoCell(cell_number, z, z, static_cast<float>(variance));
+  const Eigen::Vector2d centre = cellCenter(cell);
+  PointStats stats;
+  stats.add(static_cast<float>(point.x() - centre.x()), static_cast<float>(point.y() - centre.y()), z);
+  insertIntoCell(cell_number, z, z, static_cast<float>(variance), stats);
 }
 
 void MLMap::insertScan(const Scan& scan) {
@@ -180,6 +195,8 @@ void MLMap::insertScan(const Scan& scan) {
   std::vector<CellIndex> cells(count);
   std::vector<float> heights(count);
   std::vector<float> variances(count);
+  std::vector<float> offsets_x(count);  // m, from the cell's centre
+  std::vector<float> offsets_y(count);
   const auto signed_count = static_cast<std::int64_t>(count);
   bool all_valid = true;
 #pragma omp parallel for schedule(static) reduction(&& : all_valid)
@@ -193,6 +210,11 @@ void MLMap::insertScan(const Scan& scan) {
     cells[index] = valid ? *cell : CellIndex{};
     heights[index] = static_cast<float>(world.z());
     variances[index] = static_cast<float>(variance);
+    if (valid) {
+      const Eigen::Vector2d centre = cellCenter(*cell);
+      offsets_x[index] = static_cast<float>(world.x() - centre.x());
+      offsets_y[index] = static_cast<float>(world.y() - centre.y());
+    }
   }
   if (!all_valid) {
     for (std::size_t index = 0; index < count; ++index) insert(scan.worldPoint(index), scan.variance(index));
@@ -242,8 +264,10 @@ void MLMap::insertScan(const Scan& scan) {
       int blocks_in_cell = cell.count;
       for (std::size_t k = run.begin; k < run.end; ++k) {
         const std::uint32_t index = order[k];
+        PointStats point;
+        point.add(offsets_x[index], offsets_y[index], heights[index]);
         blocks_in_cell = addMeasurement(scratch.data(), blocks_in_cell, heights[index], heights[index],
-                                        variances[index], reach);
+                                        variances[index], reach, point);
       }
       added += blocks_in_cell - cell.count;
       scratch.resize(static_cast<std::size_t>(blocks_in_cell));
@@ -275,7 +299,7 @@ void MLMap::insertBlock(CellIndex cell_index, const Block& block) {
   // A block stands for its measurements: a horizontal one is fused like a point of
   // its variance, a vertical one joins every block its extent reaches.
   const float bottom = block.isVertical() ? block.bottom() : block.height;
-  insertIntoCell(findOrCreateCell(cell_index), block.height, bottom, block.variance);
+  insertIntoCell(findOrCreateCell(cell_index), block.height, bottom, block.variance, block.points);
 }
 
 void MLMap::restoreCell(CellIndex cell_index, std::span<const Block> blocks) {
@@ -290,7 +314,8 @@ void MLMap::restoreCell(CellIndex cell_index, std::span<const Block> blocks) {
                        std::isfinite(block.variance) && block.variance > 0.0F &&
                        block.depth >= 0.0F &&
                        (block.isVertical() || block.depth == 0.0F) &&
-                       (block.kind == BlockKind::Horizontal || block.kind == BlockKind::Vertical);
+                       (block.kind == BlockKind::Horizontal || block.kind == BlockKind::Vertical) &&
+                       validStats(block.points, cell_size_);
     // Gaps are compared with a float tolerance: they were computed in float.
     const bool ordered = k == 0 || block.bottom() - blocks[k - 1].height >= cell_size_ * (1 - 1e-4);
     if (!valid || !ordered) {

@@ -75,7 +75,17 @@ void appendStacks(std::span<const Block> cell_blocks, CellIndex cell, const Eige
       }
       level = static_cast<float>(weighted / weight);
     }
-    view.point = Eigen::Vector3f(static_cast<float>(centre.x()), static_cast<float>(centre.y()),
+    // Across, the block is where its points are: a wall turned to the grid, or on a
+    // cell boundary, stays a straight line of blocks (see point_stats.hpp). A merged
+    // map's block may hold points from just beside its cell: kept within the cell.
+    PointStats points;
+    for (std::size_t k = first; k <= last; ++k) points.merge(cell_blocks[k].points);
+    if (!points.empty()) {
+      view.offset_x = std::clamp(static_cast<float>(points.mean_x / cell_size), -0.5F, 0.5F);
+      view.offset_y = std::clamp(static_cast<float>(points.mean_y / cell_size), -0.5F, 0.5F);
+    }
+    view.point = Eigen::Vector3f(static_cast<float>(centre.x() + view.offset_x * cell_size),
+                                 static_cast<float>(centre.y() + view.offset_y * cell_size),
                                  view.vertical ? 0.5F * (view.top + view.bottom) : level);
     view.cell = cell;
     out.push_back(view);
@@ -85,7 +95,7 @@ void appendStacks(std::span<const Block> cell_blocks, CellIndex cell, const Eige
 
 }  // namespace
 
-BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_size_(map.cellSize()) {
+BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_size_(map.cellSize()), map_(&map) {
   const StackRule rule{static_cast<float>(config.stack_gap),
                        static_cast<float>(std::max(config.level_band, cell_size_)),
                        static_cast<float>(config.ladder_gap),
@@ -133,6 +143,19 @@ BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_siz
     cell_first_.push_back(static_cast<std::uint32_t>(blocks_.size()));
   }
   first_id_from_.back() = static_cast<std::uint32_t>(blocks_.size());
+}
+
+PointStats BlockGrid::pointsOf(std::uint32_t id) const {
+  // The grid cell holding the block: the last whose first block is at or before it.
+  const auto after = std::upper_bound(cell_first_.begin(), cell_first_.end() - 1, id);
+  const auto cell_number = static_cast<std::size_t>(after - cell_first_.begin()) - 1;
+  const std::span<const Block> cell_blocks = map_->blocksAt(map_cell_[cell_number]);
+  const PlaneBlock& block = blocks_[id];
+  PointStats points;
+  for (std::size_t k = block.map_first; k < std::size_t{block.map_first} + block.map_count; ++k) {
+    points.merge(cell_blocks[k].points);
+  }
+  return points;
 }
 
 std::vector<std::uint32_t> BlockGrid::idsInMapOrder(std::span<const std::uint8_t> keep,

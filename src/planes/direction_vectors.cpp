@@ -28,21 +28,23 @@ float sumOf(Lanes lanes) { return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
 
 // The neighbourhood of a cell is 2r + 1 columns of 2r + 1 cells; the next cell of its
 // row shares all but one column with it. So the blocks are gathered a column at a time
-// and kept while the window slides along the row, and the sums are taken column by
-// column: within a column a block's offset across rows, dy, is a small integer (cell
-// units), and the column's own offset dx enters when its sums are added. A column's
-// blocks, four to a vector, the last vector padded with blocks that never count:
+// and kept while the window slides along the row. A block sits where its points are
+// (PlaneBlock::offset_x, offset_y): its position across is its cell's offset from the
+// window's cell (small integers) plus its own offset, in cell units. Within a column
+// dy holds both; the column's dx enters when its blocks are summed. A column's blocks,
+// four to a vector, the last vector padded with blocks that never count:
 struct Column {
   std::int64_t j = std::numeric_limits<std::int64_t>::min();  // the grid column it holds
-  std::vector<Lanes> level_dy, level_top, level_z;            // horizontal blocks
-  std::vector<Lanes> vertical_dy, vertical_top, vertical_bottom;
+  std::vector<Lanes> level_dx, level_dy, level_top, level_z;  // horizontal blocks
+  std::vector<Lanes> vertical_dx, vertical_dy, vertical_top, vertical_bottom;
   std::size_t levels = 0;
   std::size_t verticals = 0;
 
   void clear(std::int64_t column) {
     j = column;
     levels = verticals = 0;
-    for (std::vector<Lanes>* lanes : {&level_dy, &level_top, &level_z, &vertical_dy, &vertical_top, &vertical_bottom}) {
+    for (std::vector<Lanes>* lanes : {&level_dx, &level_dy, &level_top, &level_z, &vertical_dx, &vertical_dy,
+                                      &vertical_top, &vertical_bottom}) {
       lanes->clear();
     }
   }
@@ -50,70 +52,68 @@ struct Column {
     const float infinity = std::numeric_limits<float>::infinity();
     if (block.vertical) {
       if (verticals % 4 == 0) {
+        vertical_dx.push_back(Lanes{});
         vertical_dy.push_back(Lanes{});
         vertical_top.push_back(Lanes{} - infinity);  // overlaps nothing
         vertical_bottom.push_back(Lanes{} + infinity);
       }
       const std::size_t lane = verticals++ % 4;
-      vertical_dy.back()[lane] = dy;
+      vertical_dx.back()[lane] = block.offset_x;
+      vertical_dy.back()[lane] = dy + block.offset_y;
       vertical_top.back()[lane] = block.top;
       vertical_bottom.back()[lane] = block.bottom;
     } else {
       if (levels % 4 == 0) {
+        level_dx.push_back(Lanes{});
         level_dy.push_back(Lanes{});
         level_top.push_back(Lanes{} + infinity);  // at no height near a block's
         level_z.push_back(Lanes{});
       }
       const std::size_t lane = levels++ % 4;
-      level_dy.back()[lane] = dy;
+      level_dx.back()[lane] = block.offset_x;
+      level_dy.back()[lane] = dy + block.offset_y;
       level_top.back()[lane] = block.top;
       level_z.back()[lane] = block.point.z();
     }
   }
 };
 
-// A block's sums over its kept neighbours: in cell units across, metres up relative to
-// its height. Each is four partial sums, added up at the end.
+// A block's sums over its kept neighbours: in cell units across (relative to its
+// cell's centre), metres up relative to its height. Each is four partial sums, added
+// up at the end.
 struct Moments {
   Lanes n{}, x{}, y{}, xx{}, xy{}, yy{};
   Lanes z{}, xz{}, yz{}, zz{};
 
-  // One column's kept neighbours: their count and their dy's sums (n, Σdy, Σdy²), and
-  // the height sums (Σz, Σdy·z, Σz²), placed by the column's dx.
-  void addColumn(float dx, Lanes count, Lanes dy, Lanes dy2, Lanes height, Lanes dy_height, Lanes height2) {
-    n += count;
-    x += count * dx;
-    xx += count * (dx * dx);
-    y += dy;
-    xy += dy * dx;
-    yy += dy2;
-    z += height;
-    xz += height * dx;
-    yz += dy_height;
-    zz += height2;
+  // Four neighbours: `keep` masks the ones that count; x, y across and z up.
+  void add(LaneMask keep, Lanes x_lanes, Lanes y_lanes, Lanes z_lanes) {
+    const Lanes kx = keepIf(keep, x_lanes);
+    const Lanes ky = keepIf(keep, y_lanes);
+    const Lanes kz = keepIf(keep, z_lanes);
+    n += keepIf(keep, Lanes{} + 1.0F);
+    x += kx;
+    y += ky;
+    xx += kx * x_lanes;
+    xy += kx * y_lanes;
+    yy += ky * y_lanes;
+    z += kz;
+    xz += kz * x_lanes;
+    yz += kz * y_lanes;
+    zz += kz * z_lanes;
   }
 };
 
 Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const Column* const* window, int radius,
                                     float height_tolerance, double cell, double min_spread) {
   Moments sums;
-  const Lanes ones = Lanes{} + 1.0F;
   for (int c = 0; c <= 2 * radius; ++c) {
     const Column& column = *window[c];
-    Lanes count{}, dy{}, dy2{}, height{}, dy_height{}, height2{};
+    const auto dx = static_cast<float>(c - radius);
     for (std::size_t q = 0; q < column.level_top.size(); ++q) {
       const Lanes rise = column.level_top[q] - self.top;
       const LaneMask keep = (rise < height_tolerance) & (rise > -height_tolerance);
-      const Lanes kept_dy = keepIf(keep, column.level_dy[q]);
-      const Lanes kept_z = keepIf(keep, column.level_z[q] - self.point.z());
-      count += keepIf(keep, ones);
-      dy += kept_dy;
-      dy2 += kept_dy * column.level_dy[q];
-      height += kept_z;
-      dy_height += kept_z * column.level_dy[q];
-      height2 += kept_z * kept_z;
+      sums.add(keep, column.level_dx[q] + dx, column.level_dy[q], column.level_z[q] - self.point.z());
     }
-    sums.addColumn(static_cast<float>(c - radius), count, dy, dy2, height, dy_height, height2);
   }
   const double n = sumOf(sums.n);
   if (n < 3.0) return Eigen::Vector3f::Zero();
@@ -134,19 +134,14 @@ Eigen::Vector3f horizontalDirection(const PlaneBlock& self, const Column* const*
 Eigen::Vector3f verticalDirection(const PlaneBlock& self, const Column* const* window, int radius, double cell,
                                   double min_spread) {
   Moments sums;
-  const Lanes ones = Lanes{} + 1.0F;
   for (int c = 0; c <= 2 * radius; ++c) {
     const Column& column = *window[c];
-    Lanes count{}, dy{}, dy2{};
+    const auto dx = static_cast<float>(c - radius);
     for (std::size_t q = 0; q < column.vertical_top.size(); ++q) {
       // Their extents overlap.
       const LaneMask keep = (column.vertical_bottom[q] <= self.top) & (column.vertical_top[q] >= self.bottom);
-      const Lanes kept_dy = keepIf(keep, column.vertical_dy[q]);
-      count += keepIf(keep, ones);
-      dy += kept_dy;
-      dy2 += kept_dy * column.vertical_dy[q];
+      sums.add(keep, column.vertical_dx[q] + dx, column.vertical_dy[q], Lanes{});
     }
-    sums.addColumn(static_cast<float>(c - radius), count, dy, dy2, Lanes{}, Lanes{}, Lanes{});
   }
   const double n = sumOf(sums.n);
   if (n < 2.0) return Eigen::Vector3f::Zero();
@@ -159,6 +154,42 @@ Eigen::Vector3f verticalDirection(const PlaneBlock& self, const Column* const* w
   if (solver.eigenvalues()(1) < min_spread) return Eigen::Vector3f::Zero();
   const Eigen::Vector2d normal = solver.eigenvectors().col(0);
   return orientConsistently(Eigen::Vector3f(static_cast<float>(normal.x()), static_cast<float>(normal.y()), 0.0F));
+}
+
+// The same directions for one block over any Chebyshev radius, plainly: for the few
+// blocks whose r-window was too sparse.
+Eigen::Vector3f directionInRadius(const BlockGrid& grid, std::uint32_t id, int radius, float height_tolerance,
+                                  double min_spread) {
+  const PlaneBlock& self = grid.blocks()[id];
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  double n = 0.0;
+  grid.forEachNeighbour(self.cell, radius, [&](std::uint32_t other_id) {
+    const PlaneBlock& other = grid.blocks()[other_id];
+    if (other.vertical != self.vertical) return;
+    if (self.vertical ? (other.bottom > self.top || other.top < self.bottom)
+                      : std::abs(other.top - self.top) >= height_tolerance) {
+      return;
+    }
+    Eigen::Vector3d p = (other.point - self.point).cast<double>();
+    if (self.vertical) p.z() = 0.0;
+    sum += p;
+    outer += p * p.transpose();
+    n += 1.0;
+  });
+  if (n < (self.vertical ? 2.0 : 3.0)) return Eigen::Vector3f::Zero();
+  const Eigen::Vector3d mean = sum / n;
+  const Eigen::Matrix3d covariance = outer / n - mean * mean.transpose();
+  if (self.vertical) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver;
+    solver.computeDirect(covariance.topLeftCorner<2, 2>());
+    if (solver.eigenvalues()(1) < min_spread) return Eigen::Vector3f::Zero();
+    const Eigen::Vector2d normal = solver.eigenvectors().col(0);
+    return orientConsistently(Eigen::Vector3f(static_cast<float>(normal.x()), static_cast<float>(normal.y()), 0.0F));
+  }
+  const SmallestAxis smallest = smallestAxis(covariance);
+  if (smallest.middle_eigenvalue < min_spread) return Eigen::Vector3f::Zero();
+  return orientConsistently(smallest.axis.cast<float>());
 }
 
 }  // namespace
@@ -230,6 +261,22 @@ std::vector<Eigen::Vector3f> directionVectors(const BlockGrid& grid, const Direc
                                : horizontalDirection(blocks[id], window.data(), radius, config.height_tolerance, cell, min_spread);
         }
       }
+    }
+  }
+  // Blocks left without a direction widen their window (DirectionConfig::max_radius).
+  std::vector<std::uint32_t> sparse;
+  if (config.max_radius > radius) {
+    for (std::uint32_t id = 0; id < directions.size(); ++id) {
+      if (!(directions[id].squaredNorm() > 0.0F)) sparse.push_back(id);
+    }
+  }
+  const auto sparse_count = static_cast<std::int64_t>(sparse.size());
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads) if (sparse_count > 1000)
+  for (std::int64_t k = 0; k < sparse_count; ++k) {
+    const std::uint32_t id = sparse[static_cast<std::size_t>(k)];
+    for (int wider = std::max(radius, 1) * 2; wider <= config.max_radius; wider *= 2) {
+      directions[id] = directionInRadius(grid, id, wider, config.height_tolerance, min_spread);
+      if (directions[id].squaredNorm() > 0.0F) break;
     }
   }
   return directions;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "mlmap/planes/direction_vectors.hpp"
 #include "pca_sums.hpp"
@@ -49,6 +50,10 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
       const Plane& largest = planes[k];
       const CandidatePlane reference{largest.normal.cast<float>(), largest.centroid.cast<float>()};
       for (const std::uint32_t id : patch.blocks) patch.surface += grid.blocks()[id].surface;
+      // The members are disjoint pieces of one surface: their areas add up.
+      for (std::size_t member = 0; member < count; ++member) {
+        if (roots[member] == k) patch.footprint += planes[member].area / (grid.cellSize() * grid.cellSize());
+      }
       frame = OutlineFrame{largest.normal, largest.centroid, true};
       plane = describePatch(grid, patch, reference, kappa_rad);
       plane.source = largest.source;
@@ -112,18 +117,40 @@ Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePl
     if (solver.eigenvalues()(1) > 1e-4 && std::abs(fitted.dot(normal)) > std::cos(kappa_rad)) normal = fitted;
     point = origin + mean;
   }
+  // The plane, its offset and its RMS from the patch's points where the map keeps
+  // their moments (point_stats.hpp): a least-squares fit to the points themselves,
+  // not to the blocks' positions, and the points' own residual.
+  PointMoments points;
+  for (const std::uint32_t id : patch.blocks) {
+    points.add(grid.pointsOf(id), (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[id].cell), 0.0).finished() - origin);
+  }
+  std::optional<double> points_rms;
+  if (points.count >= 3.0) {
+    const Eigen::Matrix3d covariance = points.covariance();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(covariance);
+    const Eigen::Vector3d fitted = solver.eigenvectors().col(0);
+    if (solver.eigenvalues()(1) > 1e-4 && std::abs(fitted.dot(normal)) > std::cos(kappa_rad)) normal = fitted;
+    point = origin + points.mean();
+    points_rms = std::sqrt(std::max(0.0, normal.dot(covariance * normal)));
+  }
   normal = orientConsistently(normal.cast<float>()).cast<double>();
   plane.normal = normal;
   plane.offset = -normal.dot(point);
   plane.centroid = centroid / static_cast<double>(patch.blocks.size());
-  plane.area = patch.surface * cell_area;
+  // The area the patch covers on its raster; a patch made without one, by its surface.
+  plane.area = (patch.footprint > 0.0 ? patch.footprint : patch.surface) * cell_area;
   plane.block_count = patch.blocks.size();
-  double squared = 0.0;
-  for (const std::uint32_t id : patch.blocks) {
-    const double distance = normal.dot(grid.blocks()[id].point.cast<double>()) + plane.offset;
-    squared += distance * distance;
+  if (points_rms) {
+    plane.rms = *points_rms;
+  } else {
+    double squared = 0.0;
+    for (const std::uint32_t id : patch.blocks) {
+      const double distance = normal.dot(grid.blocks()[id].point.cast<double>()) + plane.offset;
+      squared += distance * distance;
+    }
+    plane.rms = std::sqrt(squared / static_cast<double>(patch.blocks.size()));
   }
-  plane.rms = std::sqrt(squared / static_cast<double>(patch.blocks.size()));
   placeOutline(plane, patch.outline);
   return plane;
 }

@@ -6,7 +6,9 @@
 //   flags      u32      bit 0: an OcTree follows, bit 1: planes follow (version ≥ 2)
 //   cell_size, octree_resolution, max_range   f64 each, metres
 //   cell_count u64, block_count u64
-//   per cell:  i i32, j i32, n u16, then n blocks: h f32, σ f32, d f32, π i32, kind u8
+//   per cell:  i i32, j i32, n u16, then n blocks: h f32, σ f32, d f32, π i32, kind u8,
+//              and from version 3 the points' moments: count u32, mean x y z f32 (x, y
+//              from the cell's centre), scatter xx xy xz yy yz zz f32
 //   octree     u64 byte count, then OcTree::write() output (.ot stream)
 //   planes     u64 byte count, then the planes JSON (mlmap.planes/1) the labels refer to
 //   crc32      u32 over every byte before it
@@ -20,7 +22,9 @@
 
 namespace mlmap::io {
 
-constexpr std::uint32_t kMapFileVersion = 2;  // 1: no planes section; still read
+// 1: no planes section; 2: no point moments per block (both still read, their blocks
+// then sit at their cell centres for plane detection).
+constexpr std::uint32_t kMapFileVersion = 3;
 
 // Written to a temporary file and renamed: a failure leaves any old file untouched.
 void writeMap(const std::filesystem::path& path, const Map& map);

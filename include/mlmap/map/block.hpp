@@ -5,6 +5,8 @@
 
 #include <cstdint>
 
+#include "mlmap/map/point_stats.hpp"
+
 namespace mlmap {
 
 enum class BlockKind : std::uint8_t { Horizontal = 0, Vertical = 1 };
@@ -15,6 +17,9 @@ struct Block {
   float depth = 0.0F;      // m, d: the vertical extent below h; 0 for horizontal blocks
   std::int32_t plane = 0;  // π: label of the matching plane, 0 = none
   BlockKind kind = BlockKind::Horizontal;
+  // Beyond the paper's (h, σ, d, π): the moments of the points the block collected
+  // (empty for maps written before format version 3).
+  PointStats points;
 
   float bottom() const { return height - depth; }
   bool isVertical() const { return kind == BlockKind::Vertical; }

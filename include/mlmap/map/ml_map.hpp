@@ -37,7 +37,8 @@ class MLMap {
   // Adds every point of the scan, moved to the world frame by its pose.
   void insertScan(const Scan& scan);
   // Adds a finished block, as a map reader or a merge does, by the same rules: a
-  // horizontal block is fused like a measurement, a vertical one joins the blocks it reaches.
+  // horizontal block is fused like a measurement, a vertical one joins the blocks it
+  // reaches; its points' moments (relative to this cell's centre) join theirs.
   void insertBlock(CellIndex cell, const Block& block);
 
   // Restores a cell's blocks verbatim (map readers); the cell must be new and the
@@ -71,7 +72,7 @@ class MLMap {
 
   std::size_t findOrCreateCell(CellIndex cell);
   void reserveCell(Cell& cell, std::size_t capacity);
-  void insertIntoCell(std::size_t cell_number, float top, float bottom, float variance);
+  void insertIntoCell(std::size_t cell_number, float top, float bottom, float variance, const PointStats& points);
   void rehash(std::size_t slot_count);
 
   double cell_size_;

@@ -27,7 +27,11 @@
 namespace mlmap {
 
 struct PlaneBlock {
-  Eigen::Vector3f point;  // m: cell centre at h (horizontal) or mid-height (vertical)
+  // m: where its points are across (their mean x, y; the cell centre for a map without
+  // point moments) at h (horizontal) or mid-height (vertical)
+  Eigen::Vector3f point;
+  float offset_x = 0.0F;  // cells: point x, y from the cell centre, within ±0.5
+  float offset_y = 0.0F;
   float top = 0.0F;       // m, h
   float bottom = 0.0F;    // m, h − d
   float surface = 1.0F;   // surface units: 1 (horizontal) or d / cell_size (vertical)
@@ -71,6 +75,12 @@ class BlockGrid {
   // many OpenMP threads (the order visits the grid at random, a cache miss per cell).
   std::vector<std::uint32_t> idsInMapOrder(std::span<const std::uint8_t> keep = {}, int threads = 1) const;
 
+  // The moments of the points of block `id`'s map blocks, x and y from its cell's
+  // centre (cellCentre); empty for a map without point moments. The map the grid was
+  // made from must still be alive.
+  PointStats pointsOf(std::uint32_t id) const;
+  Eigen::Vector2d cellCentre(CellIndex cell) const { return {(cell.j + 0.5) * cell_size_, (cell.i + 0.5) * cell_size_}; }
+
   // Calls visit(block_id) for every block in cells within Chebyshev radius `radius` of
   // `cell`, row by row and in each cell bottom to top: ids ascending.
   template <typename Visit>
@@ -99,6 +109,7 @@ class BlockGrid {
 
  private:
   double cell_size_;
+  const MLMap* map_;
   std::vector<PlaneBlock> blocks_;
   std::vector<std::uint32_t> cell_first_;  // per cell number, plus one past the end
   std::vector<std::uint32_t> map_cell_;    // per cell number: the map's number of that cell

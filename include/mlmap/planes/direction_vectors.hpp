@@ -14,6 +14,11 @@ namespace mlmap {
 
 struct DirectionConfig {
   int radius = 2;                 // cells, Chebyshev radius r of the neighbourhood
+  // cells: a block whose r-window holds too few blocks of its class to span a surface
+  // (a ceiling far from the scanner, its scan lines further apart than r cells) widens
+  // its window, doubling r, up to this; 0 = r only. The window follows the scan spacing
+  // where it is sparse and stays r where it is dense.
+  int max_radius = 0;
   float height_tolerance = 0.08F; // m, horizontal neighbours must lie this close in height
   int threads = 0;                // OpenMP threads; 0 = OpenMP's default
 };
