@@ -65,7 +65,7 @@ void addPlanesCommand(CLI::App& app, Context& context) {
   command->add_option("--threads", config.threads, "Threads (default: all cores)")->check(CLI::NonNegativeNumber);
   command->add_option("--radius", config.radius, "r: neighbourhood radius, cells")
       ->capture_default_str()->check(CLI::PositiveNumber);
-  command->add_option("--epsilon", config.epsilon, "ε: max block-plane distance, m (default: max(cell size, min(3 σ, 0.05)))")
+  command->add_option("--epsilon", config.epsilon, "ε: max block-plane distance, m (default: max(3 σ, min(cell size, 0.05)); maps without point moments: max(cell size, min(3 σ, 0.05)))")
       ->check(CLI::NonNegativeNumber);
   command->add_option("--noise", config.noise, "σ: range noise of the map's points, m (default: from its vertical blocks)")
       ->check(CLI::NonNegativeNumber);

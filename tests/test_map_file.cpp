@@ -13,6 +13,28 @@ using namespace mlmap;
 
 namespace {
 
+// A version-3 file's bytes in an older version's layout: each block without its 40
+// bytes of point moments, the version byte set, the checksum made anew.
+std::string olderLayout(const std::string& v3, char version) {
+  constexpr std::size_t kHeader = 8 + 4 + 4 + 3 * 8;
+  std::uint64_t cells = 0;
+  std::memcpy(&cells, v3.data() + kHeader, sizeof(cells));
+  std::string out = v3.substr(0, kHeader + 16);
+  out[8] = version;
+  std::size_t at = kHeader + 16;
+  for (std::uint64_t c = 0; c < cells; ++c) {
+    std::uint16_t count = 0;
+    std::memcpy(&count, v3.data() + at + 8, sizeof(count));
+    out.append(v3, at, 10);
+    at += 10;
+    for (std::uint16_t k = 0; k < count; ++k, at += 57) out.append(v3, at, 17);
+  }
+  out.append(v3, at, v3.size() - 4 - at);
+  const std::uint32_t crc = io::crc32(out.data(), out.size());
+  out.append(reinterpret_cast<const char*>(&crc), sizeof(crc));
+  return out;
+}
+
 Map smallRoomMap(bool with_octree) {
   MapConfig config;
   config.cell_size = 0.1;
@@ -110,9 +132,10 @@ TEST_CASE("MapFile: damaged, truncated, foreign and future files are refused by 
   }
   SUBCASE("another version") {
     std::string future = good;
-    future[8] = 3;
+    future[8] = static_cast<char>(io::kMapFileVersion + 1);
     test::writeText(dir / "future.mlmap", future);
-    CHECK_THROWS_WITH_AS(io::readMap(dir / "future.mlmap"), doctest::Contains("version 3"), Error);
+    const std::string expected = "version " + std::to_string(io::kMapFileVersion + 1);
+    CHECK_THROWS_WITH_AS(io::readMap(dir / "future.mlmap"), doctest::Contains(expected.c_str()), Error);
   }
   SUBCASE("a hostile cell count with a valid checksum") {
     std::string hostile = good.substr(0, good.size() - 4);
@@ -163,16 +186,20 @@ TEST_CASE("MapFile: a labelled map keeps its planes, and version-1 files still r
   CHECK(back.planes()->config.seed == 9);
   CHECK(back.blocks().blocksAt(0)[0].plane == 7);
 
-  // A version-1 file is the version-2 layout without planes: rewrite the version byte
-  // of an unlabelled map and fix its checksum.
+  // A version-1 file is the version-2 layout without planes, and version 2 the
+  // version-3 layout without the blocks' point moments: an unlabelled map's bytes
+  // rewritten so, its checksum fixed.
   Map unlabelled = smallRoomMap(false);
-  io::writeMap(dir / "v2.mlmap", unlabelled);
-  std::string bytes = test::readText(dir / "v2.mlmap");
-  bytes[8] = 1;
-  bytes.resize(bytes.size() - 4);
-  const std::uint32_t crc = io::crc32(bytes.data(), bytes.size());
-  bytes.append(reinterpret_cast<const char*>(&crc), sizeof(crc));
+  io::writeMap(dir / "v3.mlmap", unlabelled);
+  const std::string bytes = olderLayout(test::readText(dir / "v3.mlmap"), 1);
   test::writeText(dir / "v1.mlmap", bytes);
+  const Map v2 = [&] {
+    test::writeText(dir / "v2.mlmap", olderLayout(test::readText(dir / "v3.mlmap"), 2));
+    return io::readMap(dir / "v2.mlmap");
+  }();
+  CHECK(v2.blocks().blockCount() == unlabelled.blocks().blockCount());
+  CHECK(v2.blocks().blocksAt(0)[0].points.empty());
+  CHECK_FALSE(unlabelled.blocks().blocksAt(0)[0].points.empty());
   const Map old = io::readMap(dir / "v1.mlmap");
   CHECK_FALSE(old.planes().has_value());
   CHECK(old.blocks().blockCount() == unlabelled.blocks().blockCount());

@@ -94,5 +94,5 @@ TEST_CASE("PointStats: the map's blocks hold their points' mean across the cell 
   CHECK(std::abs(floor[0].points.mean_x) < 1e-6);
   CHECK(std::abs(floor[0].points.mean_y) < 1e-6);
   // The scatter across: ten columns 1 cm apart, ten points each.
-  CHECK(floor[0].points.scatter[0] == doctest::Approx(100 * 0.0000825).epsilon(1e-3));
+  CHECK(floor[0].points.scatter[0] == doctest::Approx(100 * 0.000825).epsilon(1e-3));
 }

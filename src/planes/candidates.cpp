@@ -31,17 +31,12 @@ CandidateDraw drawCandidate(const CandidateSource& source, std::uint64_t seed, s
         source.seedable[std::uniform_int_distribution<std::size_t>(0, source.seedable.size() - 1)(random)];
     if (source.scorer.taken(first)) continue;
     const Eigen::Vector3f& first_direction = directions[first];
-    // Where the scan lines lie further apart than r cells, the window widens (as the
-    // direction vectors' did).
-    for (int radius = source.radius; radius <= std::max(source.radius, source.max_radius); radius *= 2) {
-      neighbours.clear();
-      source.grid.forEachNeighbour(source.grid.blocks()[first].cell, radius, [&](std::uint32_t id) {
-        if (id != first && !source.scorer.taken(id) && std::abs(directions[id].dot(first_direction)) >= source.cos_theta) {
-          neighbours.push_back(id);
-        }
-      });
-      if (neighbours.size() >= 2 || radius <= 0) break;
-    }
+    neighbours.clear();
+    source.grid.forEachNeighbour(source.grid.blocks()[first].cell, source.radius, [&](std::uint32_t id) {
+      if (id != first && !source.scorer.taken(id) && std::abs(directions[id].dot(first_direction)) >= source.cos_theta) {
+        neighbours.push_back(id);
+      }
+    });
     if (neighbours.size() < 2) continue;
     std::uniform_int_distribution<std::size_t> pick(0, neighbours.size() - 1);
     const std::size_t second_index = pick(random);

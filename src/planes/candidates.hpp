@@ -37,7 +37,6 @@ struct CandidateSource {
   float cos_theta = 1.0F;                       // of θ
   int max_refits = 5;                           // Algorithm 2's iterations at most
   double refit_gain = 1.0;                      // surface units
-  int max_radius = 0;                           // cells: a seed with too few neighbours in r widens it, doubling, up to this
 };
 
 // Candidate number `number` of a run seeded with `seed`: its own generator, so the

@@ -156,42 +156,6 @@ Eigen::Vector3f verticalDirection(const PlaneBlock& self, const Column* const* w
   return orientConsistently(Eigen::Vector3f(static_cast<float>(normal.x()), static_cast<float>(normal.y()), 0.0F));
 }
 
-// The same directions for one block over any Chebyshev radius, plainly: for the few
-// blocks whose r-window was too sparse.
-Eigen::Vector3f directionInRadius(const BlockGrid& grid, std::uint32_t id, int radius, float height_tolerance,
-                                  double min_spread) {
-  const PlaneBlock& self = grid.blocks()[id];
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-  double n = 0.0;
-  grid.forEachNeighbour(self.cell, radius, [&](std::uint32_t other_id) {
-    const PlaneBlock& other = grid.blocks()[other_id];
-    if (other.vertical != self.vertical) return;
-    if (self.vertical ? (other.bottom > self.top || other.top < self.bottom)
-                      : std::abs(other.top - self.top) >= height_tolerance) {
-      return;
-    }
-    Eigen::Vector3d p = (other.point - self.point).cast<double>();
-    if (self.vertical) p.z() = 0.0;
-    sum += p;
-    outer += p * p.transpose();
-    n += 1.0;
-  });
-  if (n < (self.vertical ? 2.0 : 3.0)) return Eigen::Vector3f::Zero();
-  const Eigen::Vector3d mean = sum / n;
-  const Eigen::Matrix3d covariance = outer / n - mean * mean.transpose();
-  if (self.vertical) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver;
-    solver.computeDirect(covariance.topLeftCorner<2, 2>());
-    if (solver.eigenvalues()(1) < min_spread) return Eigen::Vector3f::Zero();
-    const Eigen::Vector2d normal = solver.eigenvectors().col(0);
-    return orientConsistently(Eigen::Vector3f(static_cast<float>(normal.x()), static_cast<float>(normal.y()), 0.0F));
-  }
-  const SmallestAxis smallest = smallestAxis(covariance);
-  if (smallest.middle_eigenvalue < min_spread) return Eigen::Vector3f::Zero();
-  return orientConsistently(smallest.axis.cast<float>());
-}
-
 }  // namespace
 
 Eigen::Vector3f orientConsistently(const Eigen::Vector3f& normal) {
@@ -261,22 +225,6 @@ std::vector<Eigen::Vector3f> directionVectors(const BlockGrid& grid, const Direc
                                : horizontalDirection(blocks[id], window.data(), radius, config.height_tolerance, cell, min_spread);
         }
       }
-    }
-  }
-  // Blocks left without a direction widen their window (DirectionConfig::max_radius).
-  std::vector<std::uint32_t> sparse;
-  if (config.max_radius > radius) {
-    for (std::uint32_t id = 0; id < directions.size(); ++id) {
-      if (!(directions[id].squaredNorm() > 0.0F)) sparse.push_back(id);
-    }
-  }
-  const auto sparse_count = static_cast<std::int64_t>(sparse.size());
-#pragma omp parallel for schedule(dynamic, 256) num_threads(threads) if (sparse_count > 1000)
-  for (std::int64_t k = 0; k < sparse_count; ++k) {
-    const std::uint32_t id = sparse[static_cast<std::size_t>(k)];
-    for (int wider = std::max(radius, 1) * 2; wider <= config.max_radius; wider *= 2) {
-      directions[id] = directionInRadius(grid, id, wider, config.height_tolerance, min_spread);
-      if (directions[id].squaredNorm() > 0.0F) break;
     }
   }
   return directions;

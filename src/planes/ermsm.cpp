@@ -8,13 +8,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <numbers>
 #include <optional>
-
-#include <Eigen/Eigenvalues>
 
 #include "candidates.hpp"
 #include "fill_vector.hpp"
@@ -74,27 +70,14 @@ double rangeNoise(const MLMap& map) {
   return std::sqrt(std::max(0.0F, *middle));
 }
 
-// The points' spread across their surface, measured: per block of at least ten points,
-// the standard deviation along its points' least-spread axis (a floor block's across z,
-// a wall block's across the wall, whatever the orientation); the median over the map's
-// blocks. It holds the range noise and the surfaces' own roughness within a cell, which
-// is what a block's distance to its plane must allow for. Nothing for a map without
-// point moments (format version 2 and before).
-std::optional<double> measuredNoise(const MLMap& map) {
-  constexpr std::uint32_t kMinPoints = 10;
-  std::vector<float> spreads;
+// Whether the map's blocks keep their points' moments (format 3 and later).
+bool hasPointStats(const MLMap& map) {
   for (std::size_t n = 0; n < map.cellCount(); ++n) {
     for (const Block& block : map.blocksAt(n)) {
-      if (block.points.count < kMinPoints) continue;
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-      solver.computeDirect(block.points.scatterMatrix());
-      spreads.push_back(static_cast<float>(std::sqrt(std::max(0.0, solver.eigenvalues()(0)) / (block.points.count - 1))));
+      if (!block.points.empty()) return true;
     }
   }
-  if (spreads.size() < 100) return std::nullopt;
-  auto middle = spreads.begin() + static_cast<long>(spreads.size() / 2);
-  std::nth_element(spreads.begin(), middle, spreads.end());
-  return *middle;
+  return false;
 }
 
 class Detector {
@@ -123,7 +106,7 @@ class Detector {
   CandidateSource source() const {
     return CandidateSource{grid_, directions_, scorer_, seedable_, config_.radius,
                            static_cast<float>(std::cos(radians(config_.theta_deg))), config_.max_refits,
-                           config_.refit_gain, config_.max_radius};
+                           config_.refit_gain};
   }
   std::optional<std::size_t> bestCandidate();
   double acceptanceProbability(const Candidate& leader) const;
@@ -150,7 +133,6 @@ class Detector {
   struct Undescribed {
     CandidatePlane reference;  // the accepted plane it was split from
     double surface;            // surface units
-    double footprint;          // raster cells
   };
   std::vector<Undescribed> undescribed_;
   void describePatches();
@@ -170,7 +152,6 @@ void Detector::describePatches() {
     Patch patch;
     patch.blocks = std::move(patches_.blocks[k]);
     patch.surface = undescribed_[k].surface;
-    patch.footprint = undescribed_[k].footprint;
     Plane described = describePatch(grid_, patch, undescribed_[k].reference, kappa);
     Plane& plane = patches_.planes[k];
     described.id = plane.id;
@@ -259,7 +240,7 @@ bool Detector::accept(std::size_t index) {
     // Described after the search (describePatches), its outline traced after the merges
     // (tracePendingOutlines) on the plane it was split on.
     Plane plane;
-    undescribed_.push_back(Undescribed{accepted.plane, patch.surface, patch.footprint});
+    undescribed_.push_back(Undescribed{accepted.plane, patch.surface});
     plane.id = static_cast<std::int32_t>(patches_.planes.size() + 1);
     plane.source = accepted_;
     plane.candidates = since_acceptance_;
@@ -395,15 +376,18 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   ErmsmConfig& config = detection.config;
   config = input_config;
   if (config.noise <= 0.0) config.noise = rangeNoise(map);
-  if (std::getenv("MLMAP_DEBUG_NOISE") != nullptr) {
-    const auto measured = measuredNoise(map);
-    std::fprintf(stderr, "noise: model %.4f m, measured %.4f m\n", config.noise, measured ? *measured : -1.0);
-  }
-  if (config.max_radius == 0) config.max_radius = 4 * config.radius;
-  if (config.max_radius < 0) config.max_radius = config.radius;
   // Block heights average several points, so their scatter stays below the points':
-  // 3 σ, capped, and never less than a cell (block points sit at cell centres).
-  if (config.epsilon <= 0.0) config.epsilon = std::max(map.cellSize(), std::min(3.0 * config.noise, 0.05));
+  // 3 σ. Real surfaces are not that flat over metres: on scans made elsewhere the
+  // points' RMS to their own plane reaches 2.1 cm (3DTK's floor), 2.6 cm (its ceiling),
+  // 2.3 cm (a wall of OctoMap's fr079): ε is at least min(cell, 5 cm), about two of
+  // those. Where blocks sit at cell centres (maps without point moments, format 2 and
+  // before), never less than a cell: a wall on a cell boundary has blocks half a cell
+  // either side of it.
+  if (config.epsilon <= 0.0) {
+    const bool at_points = hasPointStats(map);
+    config.epsilon = at_points ? std::max(3.0 * config.noise, std::min(map.cellSize(), 0.05))
+                               : std::max(map.cellSize(), std::min(3.0 * config.noise, 0.05));
+  }
   // The blocks' old labels need no clearing: the write-back at the end labels every
   // map block (each lies in one eRMSM block), 0 where no patch took it.
   stats.stages.noise = stage();
@@ -417,7 +401,6 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   stats.stages.grid = stage();
   DirectionConfig direction_config;
   direction_config.radius = config.radius;
-  direction_config.max_radius = config.max_radius;
   direction_config.height_tolerance = static_cast<float>(config.epsilon);
   direction_config.threads = config.threads;
   const std::vector<Eigen::Vector3f> directions = directionVectors(grid, direction_config);

@@ -8,6 +8,7 @@
 
 #include "mlmap/planes/direction_vectors.hpp"
 #include "pca_sums.hpp"
+#include "raster_frame.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -50,10 +51,6 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
       const Plane& largest = planes[k];
       const CandidatePlane reference{largest.normal.cast<float>(), largest.centroid.cast<float>()};
       for (const std::uint32_t id : patch.blocks) patch.surface += grid.blocks()[id].surface;
-      // The members are disjoint pieces of one surface: their areas add up.
-      for (std::size_t member = 0; member < count; ++member) {
-        if (roots[member] == k) patch.footprint += planes[member].area / (grid.cellSize() * grid.cellSize());
-      }
       frame = OutlineFrame{largest.normal, largest.centroid, true};
       plane = describePatch(grid, patch, reference, kappa_rad);
       plane.source = largest.source;
@@ -86,6 +83,95 @@ void placeOutline(Plane& plane, const std::vector<Eigen::Vector3d>& corners) {
   }
 }
 
+// The area the blocks cover on the plane, not their surface: a wall on a cell boundary
+// has blocks in both cell columns, each of the wall's full height, and a wall at 45°
+// crosses √2 cells per cell of its length. Each block stands for its cell: on a level
+// plane the cells are counted (over |n_z| for its slope); on any other its cell's
+// extent along the plane's level axis u times its own extent up the plane (v) is a
+// rectangle, and the area of the rectangles' union is swept along u.
+double coveredArea(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
+                   const Eigen::Vector3d& point) {
+  const double cell = grid.cellSize();
+  if (blocks.empty()) return 0.0;
+  if (Eigen::Vector3d::UnitZ().cross(normal).norm() < RasterFrame::kLevelSine) {
+    // Block ids run row by row over the grid, a cell's blocks together: a cell's
+    // blocks in the patch are consecutive in its ascending list.
+    double distinct = 0.0;
+    const CellIndex* previous = nullptr;
+    for (const std::uint32_t id : blocks) {
+      const CellIndex& c = grid.blocks()[id].cell;
+      if (previous == nullptr || !(c == *previous)) distinct += 1.0;
+      previous = &c;
+    }
+    return distinct * cell * cell / std::abs(normal.z());
+  }
+  Eigen::Vector3d u_axis;
+  Eigen::Vector3d v_axis;
+  planeBasis(normal, u_axis, v_axis);
+  const double half_width = 0.5 * cell * (std::abs(u_axis.x()) + std::abs(u_axis.y()));
+  struct Rectangle {
+    double u_low, u_high, v_low, v_high;
+  };
+  std::vector<Rectangle> rectangles;
+  rectangles.reserve(blocks.size());
+  for (const std::uint32_t id : blocks) {
+    const PlaneBlock& block = grid.blocks()[id];
+    const Eigen::Vector2d centre = grid.cellCentre(block.cell);
+    const double u = (Eigen::Vector3d(centre.x(), centre.y(), block.point.z()) - point).dot(u_axis);
+    double low = (Eigen::Vector3d(centre.x(), centre.y(), block.bottom) - point).dot(v_axis);
+    double high = (Eigen::Vector3d(centre.x(), centre.y(), block.top) - point).dot(v_axis);
+    if (low > high) std::swap(low, high);
+    if (!block.vertical) {
+      low -= 0.5 * cell;
+      high += 0.5 * cell;
+    }
+    rectangles.push_back({u - half_width, u + half_width, low, high});
+  }
+  struct Event {
+    double u;
+    std::uint32_t rectangle;
+    bool opens;
+  };
+  std::vector<Event> events;
+  events.reserve(2 * rectangles.size());
+  for (std::uint32_t r = 0; r < rectangles.size(); ++r) {
+    events.push_back({rectangles[r].u_low, r, true});
+    events.push_back({rectangles[r].u_high, r, false});
+  }
+  std::sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.u < b.u; });
+  std::vector<std::uint32_t> active;
+  std::vector<std::pair<double, double>> spans;
+  double area = 0.0;
+  for (std::size_t e = 0; e < events.size(); ++e) {
+    if (e > 0 && events[e].u > events[e - 1].u && !active.empty()) {
+      // The slab since the last event: the union of its rectangles' v-extents.
+      spans.clear();
+      for (const std::uint32_t r : active) spans.emplace_back(rectangles[r].v_low, rectangles[r].v_high);
+      std::sort(spans.begin(), spans.end());
+      double covered = 0.0;
+      double low = spans[0].first;
+      double high = spans[0].second;
+      for (const auto& [span_low, span_high] : spans) {
+        if (span_low > high) {
+          covered += high - low;
+          low = span_low;
+        }
+        high = std::max(high, span_high);
+      }
+      covered += high - low;
+      area += covered * (events[e].u - events[e - 1].u);
+    }
+    if (events[e].opens) {
+      active.push_back(events[e].rectangle);
+    } else {
+      const auto at = std::find(active.begin(), active.end(), events[e].rectangle);
+      *at = active.back();
+      active.pop_back();
+    }
+  }
+  return area;
+}
+
 struct CellBox {
   std::int32_t min_i = std::numeric_limits<std::int32_t>::max();
   std::int32_t max_i = std::numeric_limits<std::int32_t>::min();
@@ -97,7 +183,6 @@ struct CellBox {
 
 Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad) {
   Plane plane;
-  const double cell_area = grid.cellSize() * grid.cellSize();
   PcaSums pca;
   const Eigen::Vector3d origin = reference.point.cast<double>();
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -138,8 +223,7 @@ Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePl
   plane.normal = normal;
   plane.offset = -normal.dot(point);
   plane.centroid = centroid / static_cast<double>(patch.blocks.size());
-  // The area the patch covers on its raster; a patch made without one, by its surface.
-  plane.area = (patch.footprint > 0.0 ? patch.footprint : patch.surface) * cell_area;
+  plane.area = coveredArea(grid, patch.blocks, normal, point);
   plane.block_count = patch.blocks.size();
   if (points_rms) {
     plane.rms = *points_rms;

@@ -282,14 +282,6 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
       outline_runs[static_cast<std::size_t>(patch_of_root[root_of_run[r]])].push_back(runs[r]);
     }
   }
-  // Each patch's footprint: its runs at no gap (the fine runs where runs join across
-  // gaps) are disjoint unions of its occupied raster cells.
-  const std::vector<Segment>& exact_runs = gap_cells > 1 ? column_runs.fine_runs : runs;
-  for (std::size_t r = 0; r < exact_runs.size(); ++r) {
-    const std::uint32_t run = gap_cells > 1 ? column_runs.parent_of_fine_run[r] : static_cast<std::uint32_t>(r);
-    const auto patch = static_cast<std::size_t>(patch_of_root[root_of_run[run]]);
-    patches[patch].footprint += static_cast<double>(std::int64_t{exact_runs[r].v_high} - exact_runs[r].v_low + 1);
-  }
   std::vector<std::size_t> largest_first(patches.size());
   std::iota(largest_first.begin(), largest_first.end(), std::size_t{0});
   std::stable_sort(largest_first.begin(), largest_first.end(),

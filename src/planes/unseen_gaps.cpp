@@ -85,7 +85,6 @@ void joinUnseenGaps(const BlockGrid& grid, std::vector<Patch>& patches, const Ei
                  std::back_inserter(blocks));
       into.blocks = std::move(blocks);
       into.surface += from.surface;
-      into.footprint += from.footprint;
       from = Patch{};
       run_high = std::max(run_high, piece.high);
       joined_any = true;

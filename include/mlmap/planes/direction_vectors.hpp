@@ -2,7 +2,10 @@
 // formed by the block and the blocks of the SAME class within Chebyshev radius r.
 // Horizontal blocks: 3D PCA over (x, y, h) of nearby horizontal blocks at a similar
 // height (so a table top does not mix with the floor). Vertical blocks: 2D PCA over
-// the cell centres of nearby vertical blocks whose extents overlap, giving (nx, ny, 0).
+// the positions of nearby vertical blocks whose extents overlap, giving (nx, ny, 0).
+// A block's position across is its points' mean where the map keeps it (not the
+// paper's cell centre): a wall turned to the grid is then a line of blocks, not a
+// staircase whose steps a window of r cells mistakes for the grid's axis.
 #pragma once
 
 #include <Eigen/Core>
@@ -14,11 +17,6 @@ namespace mlmap {
 
 struct DirectionConfig {
   int radius = 2;                 // cells, Chebyshev radius r of the neighbourhood
-  // cells: a block whose r-window holds too few blocks of its class to span a surface
-  // (a ceiling far from the scanner, its scan lines further apart than r cells) widens
-  // its window, doubling r, up to this; 0 = r only. The window follows the scan spacing
-  // where it is sparse and stays r where it is dense.
-  int max_radius = 0;
   float height_tolerance = 0.08F; // m, horizontal neighbours must lie this close in height
   int threads = 0;                // OpenMP threads; 0 = OpenMP's default
 };

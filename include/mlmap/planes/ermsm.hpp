@@ -14,11 +14,6 @@ namespace mlmap {
 
 struct ErmsmConfig {
   int radius = 2;                 // cells, Chebyshev radius r (direction vectors, candidate seeds)
-  // cells: where a block's r-window holds too few blocks of its kind to span a surface
-  // (scan lines further apart than r cells: a far ceiling, a fine grid), its direction
-  // vector's and its seeds' window widens, doubling r, up to this. 0 = 4 r; negative = r
-  // only (the paper). The window so follows the scan spacing where it is sparse.
-  int max_radius = 0;
   double epsilon = 0.0;           // m, max block-plane distance ε; 0 = max(cell size, min(3 σ, 0.05))
   double noise = 0.0;             // m, σ of the points' range noise; 0 = the median of the map's vertical blocks' σ
   // m: consecutive blocks of a cell closer than this are one eRMSM block (a wall's stack

@@ -14,10 +14,6 @@ namespace mlmap {
 struct Patch {
   std::vector<std::uint32_t> blocks;       // block ids, ascending
   double surface = 0.0;                    // surface units
-  // Cells of the raster it was split on that its blocks cover: its area in cells. Not
-  // its surface: a wall on a cell boundary has blocks in both cell columns, each of the
-  // wall's full height, and a wall at 45° crosses √2 cells per cell of its length.
-  double footprint = 0.0;
   std::vector<Eigen::Vector3d> outline;    // m, outer boundary on the plane, counter-clockwise about the normal
 };
 
