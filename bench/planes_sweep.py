@@ -43,7 +43,7 @@ each (build, detect, label, score), ~6 min on 2 free cores. --full runs every tu
 every seed (1-4) and every condition at every cell size. Simulations are cached in
 --out/sim (~10 s CPU each the first time).
 """
-import argparse, hashlib, json, math, os, shutil, subprocess, sys, time
+import argparse, hashlib, json, math, os, re, shutil, subprocess, sys, time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
@@ -209,7 +209,9 @@ def simulate(mlmap, scene, condition, sim_root, fresh):
 
 
 def cli_lists(mlmap, command, option):
-    return option in subprocess.run([mlmap, command, "--help"], capture_output=True, text=True).stdout
+    """Whether `mlmap COMMAND --help` lists the option (--up, not --update)."""
+    text = subprocess.run([mlmap, command, "--help"], capture_output=True, text=True).stdout
+    return re.search(re.escape(option) + r"(?![\w-])", text) is not None
 
 
 def grid(a):
