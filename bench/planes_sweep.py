@@ -260,9 +260,10 @@ def main():
     ap.add_argument("--report", action="store_true", help="print the tables of --json and stop")
     a = ap.parse_args()
     out_json = a.json or os.path.join(a.out, "sweep.json")
-    if a.report:
-        saved = json.load(open(out_json))
-        report(saved["rows"], saved["seconds"], saved.get("cpu_seconds", 0))
+    if a.report:  # --json may name several runs' files, comma-separated
+        saved = [json.load(open(f)) for f in out_json.split(",")]
+        report([r for x in saved for r in x["rows"]], sum(x["seconds"] for x in saved),
+               sum(x.get("cpu_seconds", 0) for x in saved))
         return
     if not os.path.exists(os.path.join(pb.SHARED_PEERS, "score.py")):
         sys.exit("planes_sweep: needs ../shared/peers/score.py beside the checkout")
@@ -352,7 +353,20 @@ def main():
     report(rows, elapsed, cpu)
 
 
+def with_drops(rows):
+    """Each row's drops against the aligned rows among `rows` (runs merged by --report)."""
+    aligned = {(r["scene"], r["cell"], r["condition"]): r for r in rows if r["angle"] == 0 and r["seed"] == 0}
+    for r in rows:
+        ref, base = aligned.get((r["scene"], r["cell"], r["condition"])), aligned.get((r["scene"], r["cell"], "base"))
+        r["drop"] = round(ref["f1"] - r["f1"], 4) if ref else None
+        r["drop_dc"] = round(ref["f1_dc"] - r["f1_dc"], 4) if ref else None
+        r["drop_base_dc"] = round(base["f1_dc"] - r["f1_dc"], 4) if base else None
+    return rows
+
+
 def report(rows, elapsed, cpu):
+    order = list(CONDITIONS)
+    rows = sorted(with_drops(rows), key=lambda r: (r["scene"], r["cell"], order.index(r["condition"]), r["angle"], r["seed"]))
     head = ("| scene | cell m | condition | turn deg | shift cells | seed | patches | P | R | F1 | Δ | "
             "F1 don't care | Δ | Δ base | structural found |")
     d = lambda v: "-" if v is None else f"{v:+.2f}"  # noqa: E731
