@@ -38,10 +38,12 @@ quote the other: both are printed, each with its worst drop.
 
 The default run samples the grid: every turn once per scene and cell size (the tuning
 turns with seed 1, the held-out ones with seed 2; 0 deg with seed 1 is a shift alone),
-and each other condition aligned and at 10 deg, at 5 cm cells: 56 variants, ~6 CPU-s
-each (build, detect, label, score), ~6 min on 2 free cores. --full runs every turn with
-every seed (1-4) and every condition at every cell size. Simulations are cached in
---out/sim (~10 s CPU each the first time).
+and each other condition aligned and at 10 deg, at 5 cm cells: 56 variants (60 with
+--up), ~4 CPU-s each (build, detect, label, score; 2026-12-01): ~5 min on 2 free cores,
+~55 min at a load average of 22 on 2 cores. --full runs every turn with every seed (1-4)
+and every condition at every cell size (888 variants). Simulations are cached in
+--out/sim (~10 s CPU each the first time); rows are saved after every variant, so
+--resume continues a run cut short and --report prints the tables again.
 """
 import argparse, hashlib, json, math, os, re, shutil, subprocess, sys, time
 
