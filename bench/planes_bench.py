@@ -42,18 +42,17 @@ def score(gt_xyz, labels, planes_true, pred_json=None, min_gt_points=1000):
 STRUCTURAL = ("floor", "ceiling", "wall", "table", "step")
 
 
-def overlap_review(gt_xyz, labels, planes_true, min_gt_points, out_labels):
-    """Two readings the scorer leaves out. (1) Which structural surfaces (floor, ceiling,
-    wall, table, step in the ground truth, at least 100 points) some patch matches at
-    IoU >= 0.5: the issue's "every wall, floor, ceiling, table top and step found".
-    (2) The labels with every patch that matches a ground-truth surface below the cut
-    set to none, written to out_labels: the scorer counts such a patch (a real face just
-    too small for the truth) as a false positive when a corner point touches a kept
-    surface; scored again, it is a don't-care, neither right nor wrong."""
+def structural_review(g, p, classes, min_gt_points):
+    """Two readings the scorer leaves out, from the true and the predicted label of every
+    point (arrays, -1 = none) and the true planes' classes (id -> class). (1) Which
+    structural surfaces (floor, ceiling, wall, table, step in the ground truth, at least
+    100 points) some patch matches at IoU >= 0.5: the issue's "every wall, floor, ceiling,
+    table top and step found". (2) The patches that match a ground-truth surface below the
+    cut: the scorer counts such a patch (a real face just too small for the truth) as a
+    false positive when a corner point touches a kept surface; set to none and scored
+    again, it is a don't-care, neither right nor wrong.
+    Returns (structural surfaces found, structural surfaces, ids of the don't-care patches)."""
     import numpy as np
-    g = np.loadtxt(gt_xyz, usecols=(3,), dtype=np.int64)
-    p = np.loadtxt(labels, usecols=(3,), dtype=np.int64)
-    classes = {q["id"]: q.get("class", "") for q in json.load(open(planes_true))["planes"]}
     valid = (g >= 0) & (p >= 0)
     pairs, inter = np.unique(np.stack([g[valid], p[valid]]), axis=1, return_counts=True)
     gt_ids, gt_n = np.unique(g[g >= 0], return_counts=True)
@@ -67,8 +66,34 @@ def overlap_review(gt_xyz, labels, planes_true, min_gt_points, out_labels):
                 dont_care.add(pid)
     structural = [gid for gid, n in gt_count.items() if classes.get(gid) in STRUCTURAL and n >= 100]
     missed = [gid for gid in structural if gid not in matched_gt]
+    return len(structural) - len(missed), len(structural), dont_care
+
+
+def overlap_review(gt_xyz, labels, planes_true, min_gt_points, out_labels):
+    """structural_review on files; writes the labels with the don't-care patches set to
+    none to out_labels. Returns (found, structural, number of don't-care patches)."""
+    import numpy as np
+    g = np.loadtxt(gt_xyz, usecols=(3,), dtype=np.int64)
+    p = np.loadtxt(labels, usecols=(3,), dtype=np.int64)
+    classes = {q["id"]: q.get("class", "") for q in json.load(open(planes_true))["planes"]}
+    found, structural, dont_care = structural_review(g, p, classes, min_gt_points)
     np.savetxt(out_labels, np.where(np.isin(p, list(dont_care)), -1, p), fmt="%d")
-    return len(structural) - len(missed), len(structural), len(dont_care)
+    return found, structural, len(dont_care)
+
+
+def build_detect_label(mlmap, scans, poses, cell, m, ml, pj, lab, range_sigma=0.01, build_args=(),
+                       planes_args=(), label_args=()):
+    """The pipeline the figures come from: the block layer of the scans at their poses
+    (written to m), the planes detected (the labelled map ml, the JSON pj) and every point
+    labelled with its patch (lab, in scan order, as the simulator's all_world.xyz).
+    Returns the build's wall time in s."""
+    t0 = time.monotonic()
+    run([mlmap, "-q", "build", "-o", m, "--poses", poses, "--cell-size", str(cell),
+         "--range-sigma", str(range_sigma), "--no-octree", *build_args] + scans)
+    build_s = time.monotonic() - t0
+    run([mlmap, "-q", "planes", m, "--json", pj, "-o", ml, *planes_args])
+    run([mlmap, "-q", "label", ml, "--poses", poses, "-o", lab, *label_args] + scans)
+    return build_s
 
 
 def eransac_candidates(n, total, p_t=0.99):
@@ -120,12 +145,7 @@ def main():
             tag = f"{scene}-{cell:g}"
             m, ml = os.path.join(a.out, tag + ".mlmap"), os.path.join(a.out, tag + ".labelled.mlmap")
             pj, lab = os.path.join(a.out, tag + ".planes.json"), os.path.join(a.out, tag + ".labels.xyz")
-            t0 = time.monotonic()
-            run([mlmap, "-q", "build", "-o", m, "--poses", poses, "--cell-size", str(cell),
-                 "--range-sigma", "0.01", "--no-octree"] + scans)
-            build_s = time.monotonic() - t0
-            run([mlmap, "-q", "planes", m, "--json", pj, "-o", ml])
-            run([mlmap, "-q", "label", ml, "--poses", poses, "-o", lab] + scans)
+            build_s = build_detect_label(mlmap, scans, poses, cell, m, ml, pj, lab)
             J = json.load(open(pj))
             detect_times = [J["timings"]["total_s"]]
             for _ in range(a.repeat - 1):

@@ -1,0 +1,106 @@
+// Plane detection must not depend on how the building lies on the map grid (issue 19):
+// a box room scanned by the simulator, axis-aligned and turned about z, its four walls
+// each found as one patch with the true normal.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "mlmap/map/ml_map.hpp"
+#include "mlmap/planes/ermsm.hpp"
+#include "mlmap/sim/placement.hpp"
+#include "mlmap/sim/scene.hpp"
+#include "mlmap/sim/simulator.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+// 6 m x 4 m x 2.5 m, empty, two poses; the shipped scenes' beams (0.25 deg), scan lines
+// 1 deg apart (2.5 times the lab's) to stay fast. Turned 7 or 10 deg, the 6 m walls are
+// lost today at this density; with 0.5 deg beams or from one pose they are found.
+constexpr const char* kBoxRoomJson = R"({
+  "scan_pattern": {"angular_step_deg": 0.25, "tilt_start_deg": -60, "tilt_end_deg": 60,
+                   "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
+  "poses": [{"x": 2.2, "y": 1.7, "yaw_deg": 20}, {"x": 4.1, "y": 2.4, "yaw_deg": 200}],
+  "surfaces": [
+    {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [6, 4, 0]},
+    {"type": "rectangle", "class": "ceiling", "min": [0, 0, 2.5], "max": [6, 4, 2.5]},
+    {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 4, 2.5]},
+    {"type": "rectangle", "class": "wall", "min": [6, 0, 0], "max": [6, 4, 2.5]},
+    {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [6, 0, 2.5]},
+    {"type": "rectangle", "class": "wall", "min": [0, 4, 0], "max": [6, 4, 2.5]}
+  ]
+})";
+
+struct WallFinding {
+  int patches = 0;             // patches lying on the wall (centroid within 10 cm, normal within 20 deg)
+  double normal_error_deg = 180.0;  // of the largest of them
+  double area_share = 0.0;     // its area over the wall's
+};
+
+// The room turned by `yaw_deg` about z (and moved by a fraction of a 5 cm cell, so its
+// walls do not lie on cell boundaries), simulated, mapped in 5 cm cells; for every wall,
+// the patches that lie on it.
+std::vector<WallFinding> wallsOfTurnedRoom(double yaw_deg) {
+  sim::Scene scene = sim::parseScene(kBoxRoomJson, "box_room.json");
+  sim::transformScene(scene, sim::Placement{0.013, 0.021, yaw_deg});
+  MLMap map(0.05);
+  for (const sim::SimulatedScan& simulated : sim::simulate(scene)) {
+    const Scan& scan = simulated.scan;
+    for (std::size_t k = 0; k < scan.size(); ++k) map.insert(scan.worldPoint(k), scan.variance(k));
+  }
+  const PlaneDetection detection = detectPlanes(map);
+  std::vector<WallFinding> walls;
+  for (const sim::GroundTruthPlane& truth : scene.ground_truth) {
+    if (truth.surface_class != sim::SurfaceClass::Wall) continue;
+    // A wall facing ±x (before the turn: |n_x| > |n_y| after it, below 45 deg) is 4 m long.
+    const double wall_area = 2.5 * (std::abs(truth.normal.x()) > std::abs(truth.normal.y()) ? 4.0 : 6.0);
+    WallFinding wall;
+    double largest = 0.0;
+    for (const Plane& patch : detection.planes) {
+      const double along = std::abs(patch.normal.dot(truth.normal));
+      if (std::abs(truth.normal.dot(patch.centroid) + truth.d) > 0.1 ||
+          along < std::cos(20.0 * std::numbers::pi / 180.0))
+        continue;
+      ++wall.patches;
+      if (patch.area > largest) {
+        largest = patch.area;
+        wall.normal_error_deg = std::acos(std::min(1.0, along)) * 180.0 / std::numbers::pi;
+        wall.area_share = patch.area / wall_area;
+      }
+    }
+    walls.push_back(wall);
+  }
+  return walls;
+}
+
+void checkEachWallOnePatch(double yaw_deg) {
+  const std::vector<WallFinding> walls = wallsOfTurnedRoom(yaw_deg);
+  REQUIRE(walls.size() == 4);
+  for (std::size_t w = 0; w < walls.size(); ++w) {
+    CAPTURE(w);
+    CAPTURE(walls[w].patches);
+    CAPTURE(walls[w].area_share);
+    CHECK(walls[w].patches == 1);
+    CHECK(walls[w].normal_error_deg < 2.0);
+    CHECK(walls[w].area_share > 0.7);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("Planes turned: a box room along the grid gives each wall one patch along its normal") {
+  checkEachWallOnePatch(0.0);
+}
+
+// Fails today (issue 19): the two 6 m walls get no patch (at 10 deg too; at 2, 5, 15, 22.5
+// and 45 deg all four are found). The issue measured the cause on the lab: the
+// direction-vector window sits in one straight run of a wall's cell staircase. may_fail
+// until the detector handles any orientation; then drop the decorator.
+TEST_CASE("Planes turned: a box room turned 7 deg gives each wall one patch along its normal" *
+          doctest::may_fail()) {
+  checkEachWallOnePatch(7.0);
+}
