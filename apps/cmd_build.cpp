@@ -108,6 +108,9 @@ void addBuildCommand(CLI::App& app, Context& context) {
   command->add_option("--max-range", options->map.max_range,
                       "Cut OcTree rays at this range, m (default: no limit)");
   command->add_flag("--no-octree", options->no_octree, "Build the block layer only");
+  command->add_flag("--exact-rays", options->map.exact_rays,
+                    "One OcTree ray per point (OctoMap's insertPointCloud with discretize = false); "
+                    "default: one ray to the centre of each voxel holding end points (discretize = true)");
   command->add_option("--range-sigma", options->range_sigma,
                       "Range noise of scans that carry no per-point variance, m "
                       "(default: the UTM-30LX's 0.03)")

@@ -14,7 +14,9 @@ namespace mlmap::cli {
 namespace {
 
 int runInfo(const std::string& path, bool as_json) {
-  const Map map = io::readMap(path);
+  // The OcTree section is counted, not built: a large map's tree took seconds to allocate.
+  const io::MapSummary summary = io::readMapSummary(path);
+  const Map& map = summary.map;
   const MLMapStats stats = map.blocks().stats();
   nlohmann::json info;
   info["file"] = path;
@@ -30,20 +32,14 @@ int runInfo(const std::string& path, bool as_json) {
   info["memory_bytes"] = {{"blocks", stats.memory_bytes}};
   const double bytes_per_block =
       stats.blocks == 0 ? 0.0 : static_cast<double>(stats.memory_bytes) / static_cast<double>(stats.blocks);
-  if (map.hasOctree()) {
-    const auto& tree = map.octree();
-    std::size_t occupied = 0;
-    std::size_t leaves = 0;
-    for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
-      ++leaves;
-      occupied += tree.isNodeOccupied(*it) ? 1 : 0;
-    }
-    info["octree"] = {{"resolution", tree.getResolution()},
-                      {"nodes", tree.size()},
-                      {"leaves", leaves},
-                      {"occupied_leaves", occupied},
-                      {"free_leaves", leaves - occupied}};
-    info["memory_bytes"]["octree"] = tree.memoryUsage();
+  if (summary.octree) {
+    const io::OctreeSummary& tree = *summary.octree;
+    info["octree"] = {{"resolution", tree.resolution},
+                      {"nodes", tree.nodes},
+                      {"leaves", tree.leaves},
+                      {"occupied_leaves", tree.occupied_leaves},
+                      {"free_leaves", tree.leaves - tree.occupied_leaves}};
+    info["memory_bytes"]["octree"] = tree.memory_bytes;
   }
   // Planes by class, when the map is labelled (mlmap planes -o).
   struct ClassTotal {
@@ -76,7 +72,7 @@ int runInfo(const std::string& path, bool as_json) {
               stats.max.x(), stats.min.y(), stats.max.y(), stats.min.z(), stats.max.z());
   std::printf("  block memory   %.1f MB (%.1f bytes/block)\n", static_cast<double>(stats.memory_bytes) / 1e6,
               bytes_per_block);
-  if (map.hasOctree()) {
+  if (summary.octree) {
     const auto& octree = info["octree"];
     std::printf("  OcTree         %.3g m, %zu nodes, %zu leaves (%zu occupied, %zu free), %.1f MB\n",
                 static_cast<double>(octree["resolution"]), static_cast<std::size_t>(octree["nodes"]),

@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "passive_wait.hpp"
 #include "mlmap/error.hpp"
 
 namespace {
@@ -27,6 +28,7 @@ void keepFreedMemory() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  mlmap::cli::preferPassiveWaiting(argv);
   keepFreedMemory();
   CLI::App app{"mlmap: Multi-Level maps from 3D laser scans, and the planes in them"};
   app.set_version_flag("--version", "mlmap 0.1.0");

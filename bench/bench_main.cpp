@@ -1,6 +1,7 @@
 // mlmap_bench: the speed and size figures of the README, printed, never asserted.
 //   mlmap_bench [SCENE.json] [--quick]
 //   mlmap_bench icp SCENE_DIR [--runs N]   (pairwise ICP, see icp_pairs.cpp)
+//   mlmap_bench octree --poses POSES.txt SCAN...   (the OcTree layer alone, see octree_insert.cpp)
 // Simulates the scene (default maps/lab.json), then times insertion into the block
 // layer alone and the OcTree alone on the same points, and reports map sizes at
 // several cell sizes.
@@ -13,6 +14,7 @@
 #include <thread>
 
 #include "icp_pairs.hpp"
+#include "octree_insert.hpp"
 #include "threads.hpp"
 #include "mlmap/map/map.hpp"
 #include "mlmap/sim/scene.hpp"
@@ -47,6 +49,7 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
+  if (argc > 1 && std::strcmp(argv[1], "octree") == 0) return mlmap::bench::runOctreeInsert(argc - 1, argv + 1);
   std::string scene_path = std::string(MLMAP_SOURCE_DIR) + "/maps/lab.json";
   bool quick = false;
   for (int k = 1; k < argc; ++k) {
@@ -86,7 +89,8 @@ int main(int argc, char** argv) {
       }
     }
     std::printf("\nInsertion, true poses: the block layer, mlmap's OcTree layer and OctoMap's own\n"
-                "insertPointCloud, each timed alone on the same points (Mpt/s = million points/s)\n");
+                "insertPointCloud (discretized, as the layer), each timed alone on the same points\n"
+                "(Mpt/s = million points/s)\n");
     std::printf("  %-6s %9s %9s %8s %8s %8s %9s %9s %9s %9s\n", "cell", "cells", "blocks",
                 "vertical", "B/block", "blocks", "OcTree", "OctoMap", "OcTree MB", "ratio");
     std::printf("  %-6s %9s %9s %8s %8s %8s %9s %9s %9s %9s\n", "m", "", "", "", "", "Mpt/s",
@@ -126,9 +130,11 @@ int main(int argc, char** argv) {
         start = Clock::now();
         for (std::size_t k = 0; k < scans.size(); ++k) {
           const Eigen::Vector3d origin = scans[k].pose.translation();
-          reference.insertPointCloud(clouds[k], octomap::point3d(static_cast<float>(origin.x()),
-                                                                 static_cast<float>(origin.y()),
-                                                                 static_cast<float>(origin.z())));
+          // discretize = true: the semantics of mlmap's OcTree layer (one ray per end voxel).
+          reference.insertPointCloud(clouds[k],
+                                     octomap::point3d(static_cast<float>(origin.x()), static_cast<float>(origin.y()),
+                                                      static_cast<float>(origin.z())),
+                                     -1.0, false, true);
         }
         octomap_seconds = secondsSince(start);
       }

@@ -212,3 +212,56 @@ TEST_CASE("MapFile: a labelled map keeps its planes, and version-1 files still r
   CHECK_FALSE(changed.planes().has_value());
   CHECK(changed.blocks().stats().labelled_blocks == 0);
 }
+
+TEST_CASE("MapFile: CRC-32 is zlib's (IEEE 802.3), also taken in pieces") {
+  const std::string check = "123456789";
+  CHECK(io::crc32(check.data(), check.size()) == 0xCBF43926U);
+  CHECK(io::crc32(check.data() + 4, 5, io::crc32(check.data(), 4)) == 0xCBF43926U);
+  CHECK(io::crc32(nullptr, 0) == 0U);
+}
+
+TEST_CASE("MapFile: the summary counts the OcTree section as the built tree reports it") {
+  test::TempDir dir;
+  const Map map = smallRoomMap(true);
+  io::writeMap(dir / "room.mlmap", map);
+  const io::MapSummary summary = io::readMapSummary(dir / "room.mlmap");
+  CHECK_FALSE(summary.map.hasOctree());
+  CHECK(summary.map.blocks().blockCount() == map.blocks().blockCount());
+  REQUIRE(summary.octree.has_value());
+  const octomap::OcTree& tree = map.octree();
+  std::size_t occupied = 0;
+  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) occupied += tree.isNodeOccupied(*it) ? 1 : 0;
+  CHECK(summary.octree->resolution == tree.getResolution());
+  CHECK(summary.octree->nodes == tree.size());
+  CHECK(summary.octree->leaves == tree.getNumLeafNodes());
+  CHECK(summary.octree->occupied_leaves == occupied);
+  CHECK(summary.octree->memory_bytes == tree.memoryUsage());
+  io::writeMap(dir / "blocks.mlmap", smallRoomMap(false));
+  CHECK_FALSE(io::readMapSummary(dir / "blocks.mlmap").octree.has_value());
+}
+
+TEST_CASE("MapFile: the summary refuses a damaged OcTree section that the checksum covers") {
+  test::TempDir dir;
+  const Map map = smallRoomMap(true);
+  io::writeMap(dir / "room.mlmap", map);
+  const std::string good = test::readText(dir / "room.mlmap");
+  const std::size_t data_line = good.find("data\n");
+  REQUIRE(data_line != std::string::npos);
+  const auto resealed = [](std::string body) {
+    const std::uint32_t crc = io::crc32(body.data(), body.size());
+    body.append(reinterpret_cast<const char*>(&crc), sizeof(crc));
+    return body;
+  };
+  SUBCASE("a node claims children the stream does not hold") {
+    std::string damaged = good.substr(0, good.size() - 4);
+    damaged[data_line + 5 + 4] = static_cast<char>(0xFF);  // the root's child bits
+    test::writeText(dir / "damaged.mlmap", resealed(damaged));
+    CHECK_THROWS_WITH_AS(io::readMapSummary(dir / "damaged.mlmap"), doctest::Contains("OcTree byte"), Error);
+  }
+  SUBCASE("a header that is not an OcTree's") {
+    std::string damaged = good.substr(0, good.size() - 4);
+    damaged.replace(damaged.find("id OcTree"), 9, "id OcTreX");
+    test::writeText(dir / "damaged.mlmap", resealed(damaged));
+    CHECK_THROWS_WITH_AS(io::readMapSummary(dir / "damaged.mlmap"), doctest::Contains("not OcTree"), Error);
+  }
+}

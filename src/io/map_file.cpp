@@ -3,6 +3,7 @@
 #include <bit>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -134,7 +135,11 @@ void writeMap(const std::filesystem::path& path, const Map& map) {
   writeWholeFile(path, out);
 }
 
-Map readMap(const std::filesystem::path& path) {
+namespace {
+
+// Reads the whole file; with `summary`, the OcTree section is only counted into it and
+// the map returned has no OcTree.
+Map readMapFile(const std::filesystem::path& path, std::optional<OctreeSummary>* summary) {
   const std::string bytes = readWholeFile(path);
   const std::string name = path.string();
   if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
@@ -224,7 +229,15 @@ Map readMap(const std::filesystem::path& path) {
     in.fail("the OcTree claims " + std::to_string(octree_size) + " bytes, " +
             std::to_string(in.remaining()) + " remain");
   }
-  if (config.with_octree) {
+  if (config.with_octree && summary != nullptr) {
+    const std::size_t octree_offset = in.offset();
+    try {
+      *summary = summarizeOctree(in.take(octree_size, "the OcTree"));
+    } catch (const Error& error) {
+      in.failAt(octree_offset, error.what());
+    }
+    map.setOctree(nullptr);
+  } else if (config.with_octree) {
     const std::size_t octree_offset = in.offset();
     std::istringstream stream(std::string(in.take(octree_size, "the OcTree")));
     CapturedCerr octomap_says;
@@ -257,6 +270,16 @@ Map readMap(const std::filesystem::path& path) {
   }
   map.blocks().compact();
   return map;
+}
+
+}  // namespace
+
+Map readMap(const std::filesystem::path& path) { return readMapFile(path, nullptr); }
+
+MapSummary readMapSummary(const std::filesystem::path& path) {
+  std::optional<OctreeSummary> octree;
+  Map map = readMapFile(path, &octree);
+  return {std::move(map), octree};
 }
 
 }  // namespace mlmap::io

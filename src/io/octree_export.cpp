@@ -103,9 +103,15 @@ void writeColouredOctree(const std::filesystem::path& path, const Map& map) {
 
 void writeBinaryOctree(const std::filesystem::path& path, const Map& map) {
   if (!map.hasOctree()) throw Error(path.string() + ": the map has no OcTree (it was built with --no-octree)");
+  // A .bt holds two bits a node, occupied or free: the maximum-likelihood tree, whose
+  // leaves of one state merge once pruned (as OctoMap's own writeBinary does, here on a
+  // copy: the map keeps its log-odds). Unpruned it was 1.84x the size of OctoMap's.
+  octomap::OcTree tree(map.octree());
+  tree.toMaxLikelihood();
+  tree.prune();
   writeAtomically(path, [&](std::ostream& out) {
     const CapturedCerr quiet;
-    if (!map.octree().writeBinaryConst(out)) throw Error("OctoMap could not write the OcTree");
+    if (!tree.writeBinaryConst(out)) throw Error("OctoMap could not write the OcTree");
   });
 }
 

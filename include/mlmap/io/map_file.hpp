@@ -17,7 +17,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 
+#include "mlmap/io/octree_summary.hpp"
 #include "mlmap/map/map.hpp"
 
 namespace mlmap::io {
@@ -32,5 +34,13 @@ void writeMap(const std::filesystem::path& path, const Map& map);
 // Throws mlmap::Error naming the file and the byte offset for a damaged file, a file
 // of another version, or anything that is not an .mlmap file.
 Map readMap(const std::filesystem::path& path);
+
+// The map without its OcTree (hasOctree() false), and what the OcTree section holds,
+// counted without building it (nullopt when the file has none): for `mlmap info`.
+struct MapSummary {
+  Map map;
+  std::optional<OctreeSummary> octree;
+};
+MapSummary readMapSummary(const std::filesystem::path& path);
 
 }  // namespace mlmap::io

@@ -1,6 +1,6 @@
 // OcTree exports for OctoMap's tools: a ColorOcTree (.ot) whose occupied voxels carry
 // the colour of the plane their block belongs to, for octovis; and the plain
-// occupancy tree (.bt, OctoMap's compact binary format).
+// occupancy tree (.bt, OctoMap's compact binary format: maximum likelihood, pruned).
 #pragma once
 
 #include <filesystem>

@@ -18,6 +18,9 @@ struct MapConfig {
   double octree_resolution = 0.0;   // m, OcTree voxel size; 0 = same as cell_size
   double max_range = -1.0;          // m, rays are cut here for the OcTree; < 0 = no limit
   bool with_octree = true;          // false builds the block layer only
+  // OcTree rays: false = one ray per voxel holding end points, to its centre (OctoMap's
+  // insertPointCloud with discretize = true); true = one ray per point (discretize = false).
+  bool exact_rays = false;
 };
 
 class Map {

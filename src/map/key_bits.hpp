@@ -1,0 +1,133 @@
+// A set of OcTree voxel keys as bitmaps over 16³-voxel chunks, for the keys one scan
+// touches. Rays visit neighbouring voxels one after another, so a set bit costs a shift
+// and an OR in the chunk the previous voxel used (one hash look-up per chunk change);
+// node-based key sets cost an allocation per key and a serial merge.
+//
+// Bits inside a chunk and chunks among themselves are numbered in Morton order (x in
+// the lowest bit of each triple, as OctoMap's child index), so walking a set's chunks
+// in ascending code and each chunk's bits in ascending order visits the keys in the
+// order of a depth-first walk of the OcTree.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <octomap/OcTreeKey.h>
+
+namespace mlmap::detail {
+
+inline constexpr unsigned kChunkBits = 4;  // 16 voxels a side
+inline constexpr std::size_t kChunkWords = (std::size_t{1} << (3 * kChunkBits)) / 64;
+using ChunkWords = std::array<std::uint64_t, kChunkWords>;
+
+// Spreads the low 16 bits of v to every third bit (bit i -> bit 3i).
+constexpr std::uint64_t spreadBits(std::uint64_t v) {
+  v &= 0xFFFFU;
+  v = (v | (v << 16)) & 0x0000FF0000FFULL;
+  v = (v | (v << 8)) & 0x00F00F00F00FULL;
+  v = (v | (v << 4)) & 0x0C30C30C30C3ULL;
+  v = (v | (v << 2)) & 0x249249249249ULL;
+  return v;
+}
+
+constexpr std::uint64_t compactBits(std::uint64_t v) {
+  v &= 0x249249249249ULL;
+  v = (v | (v >> 2)) & 0x0C30C30C30C3ULL;
+  v = (v | (v >> 4)) & 0x00F00F00F00FULL;
+  v = (v | (v >> 8)) & 0x0000FF0000FFULL;
+  v = (v | (v >> 16)) & 0xFFFFU;
+  return v;
+}
+
+// The 48-bit Morton code of a key and back.
+inline std::uint64_t mortonOf(const octomap::OcTreeKey& key) {
+  return spreadBits(key[0]) | (spreadBits(key[1]) << 1) | (spreadBits(key[2]) << 2);
+}
+inline octomap::OcTreeKey keyOfMorton(std::uint64_t code) {
+  return octomap::OcTreeKey(static_cast<octomap::key_type>(compactBits(code)),
+                            static_cast<octomap::key_type>(compactBits(code >> 1)),
+                            static_cast<octomap::key_type>(compactBits(code >> 2)));
+}
+
+class KeyBits {
+ public:
+  KeyBits() : slots_(64, 0), slot_index_(64, 0) {}
+
+  void insert(unsigned x, unsigned y, unsigned z) {
+    const std::uint64_t chunk = (x >> kChunkBits) | (static_cast<std::uint64_t>(y >> kChunkBits) << 16) |
+                                (static_cast<std::uint64_t>(z >> kChunkBits) << 32);
+    if (chunk != cached_chunk_) {
+      cached_chunk_ = chunk;
+      cached_words_ = &words_[chunkIndex(spreadBits(x >> kChunkBits) | (spreadBits(y >> kChunkBits) << 1) |
+                                         (spreadBits(z >> kChunkBits) << 2))];
+    }
+    const unsigned mask = (1U << kChunkBits) - 1;
+    const unsigned bit = kInChunk[x & mask] | (kInChunk[y & mask] << 1) | (kInChunk[z & mask] << 2);
+    (*cached_words_)[bit >> 6] |= std::uint64_t{1} << (bit & 63U);
+  }
+  void insert(const octomap::OcTreeKey& key) { insert(key[0], key[1], key[2]); }
+
+  // The chunks in the order they were first touched, by Morton code of the chunk.
+  const std::vector<std::uint64_t>& chunkCodes() const { return codes_; }
+  const ChunkWords& chunkAt(std::size_t index) const { return words_[index]; }
+  // The words of the chunk with this code, or nullptr.
+  const ChunkWords* find(std::uint64_t code) const {
+    const std::size_t mask = slots_.size() - 1;
+    for (std::size_t s = hashOf(code) & mask;; s = (s + 1) & mask) {
+      if (slots_[s] == 0) return nullptr;
+      if (slots_[s] == code + 1) return &words_[slot_index_[s]];
+    }
+  }
+
+ private:
+  static constexpr std::array<unsigned, 1U << kChunkBits> kInChunk = [] {
+    std::array<unsigned, 1U << kChunkBits> table{};
+    for (unsigned v = 0; v < table.size(); ++v) table[v] = static_cast<unsigned>(spreadBits(v));
+    return table;
+  }();
+
+  static std::size_t hashOf(std::uint64_t code) {
+    return static_cast<std::size_t>((code * 0x9E3779B97F4A7C15ULL) >> 20);
+  }
+
+  std::size_t chunkIndex(std::uint64_t code) {
+    std::size_t mask = slots_.size() - 1;
+    for (std::size_t s = hashOf(code) & mask;; s = (s + 1) & mask) {
+      if (slots_[s] == code + 1) return slot_index_[s];
+      if (slots_[s] != 0) continue;
+      if (2 * (codes_.size() + 1) > slots_.size()) {
+        grow();
+        mask = slots_.size() - 1;
+        s = hashOf(code) & mask;
+        while (slots_[s] != 0) s = (s + 1) & mask;
+      }
+      slots_[s] = code + 1;
+      slot_index_[s] = static_cast<std::uint32_t>(codes_.size());
+      codes_.push_back(code);
+      words_.emplace_back();
+      return codes_.size() - 1;
+    }
+  }
+
+  void grow() {
+    slots_.assign(slots_.size() * 2, 0);
+    slot_index_.assign(slots_.size(), 0);
+    const std::size_t mask = slots_.size() - 1;
+    for (std::size_t index = 0; index < codes_.size(); ++index) {
+      std::size_t s = hashOf(codes_[index]) & mask;
+      while (slots_[s] != 0) s = (s + 1) & mask;
+      slots_[s] = codes_[index] + 1;
+      slot_index_[s] = static_cast<std::uint32_t>(index);
+    }
+  }
+
+  std::vector<std::uint64_t> slots_;       // chunk code + 1; 0 = empty
+  std::vector<std::uint32_t> slot_index_;  // index into codes_ and words_
+  std::vector<std::uint64_t> codes_;
+  std::vector<ChunkWords> words_;
+  std::uint64_t cached_chunk_ = ~std::uint64_t{0};
+  ChunkWords* cached_words_ = nullptr;
+};
+
+}  // namespace mlmap::detail

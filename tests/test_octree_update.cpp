@@ -1,0 +1,153 @@
+// The OcTree layer's ray insertion equals OctoMap's own insertPointCloud, voxel for
+// voxel, with either semantics (discretize true and false) and with a range limit.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "mlmap/map/map.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+// A 4 x 3 x 2.5 m box room scanned from `origin`: a fan of rays, each ending on the
+// first wall it meets, plus a table top that shadows part of the floor.
+Scan roomScan(const Eigen::Vector3d& origin, double yaw) {
+  Scan scan;
+  scan.pose = Eigen::Translation3d(origin) * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d low(-2.0, -1.5, 0.0);
+  const Eigen::Vector3d high(2.0, 1.5, 2.5);
+  const Eigen::Matrix3d rotation = scan.pose.rotation();
+  for (double elevation = -1.3; elevation <= 1.3; elevation += 0.045) {
+    for (double azimuth = -3.1; azimuth <= 3.1; azimuth += 0.037) {
+      const Eigen::Vector3d local(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                                  std::sin(elevation));
+      const Eigen::Vector3d direction = rotation * local;
+      double range = 1e9;
+      for (int axis = 0; axis < 3; ++axis) {
+        if (direction[axis] > 1e-9) range = std::min(range, (high[axis] - origin[axis]) / direction[axis]);
+        if (direction[axis] < -1e-9) range = std::min(range, (low[axis] - origin[axis]) / direction[axis]);
+      }
+      if (direction.z() < -1e-9) {  // the table top at z = 0.7 over x, y in [0.5, 1.5] x [-0.5, 0.5]
+        const double to_table = (0.7 - origin.z()) / direction.z();
+        const Eigen::Vector3d at = origin + to_table * direction;
+        if (to_table > 0 && at.x() > 0.5 && at.x() < 1.5 && std::abs(at.y()) < 0.5) range = std::min(range, to_table);
+      }
+      scan.points.push_back(local * range);
+    }
+  }
+  return scan;
+}
+
+std::vector<Scan> roomScans() {
+  std::vector<Scan> scans;
+  const std::vector<Eigen::Vector3d> origins{{0.013, 0.021, 1.204}, {-1.1, 0.6, 0.9}, {1.3, -0.8, 1.5}, {0.4, 0.9, 0.35}};
+  for (int round = 0; round < 2; ++round) {  // twice: voxels saturate and whole nodes prune
+    for (std::size_t k = 0; k < origins.size(); ++k) scans.push_back(roomScan(origins[k], 0.3 * static_cast<double>(k)));
+  }
+  return scans;
+}
+
+octomap::OcTree octomapReference(const std::vector<Scan>& scans, double resolution, double max_range, bool discretize) {
+  octomap::OcTree tree(resolution);
+  for (const Scan& scan : scans) {
+    octomap::Pointcloud cloud;
+    for (std::size_t p = 0; p < scan.size(); ++p) {
+      const Eigen::Vector3d world = scan.worldPoint(p);
+      cloud.push_back(static_cast<float>(world.x()), static_cast<float>(world.y()), static_cast<float>(world.z()));
+    }
+    const Eigen::Vector3d origin = scan.pose.translation();
+    tree.insertPointCloud(cloud,
+                          octomap::point3d(static_cast<float>(origin.x()), static_cast<float>(origin.y()),
+                                           static_cast<float>(origin.z())),
+                          max_range, false, discretize);
+  }
+  return tree;
+}
+
+// Every finest voxel one tree knows (pruned leaves stand for all voxels inside them)
+// has the same log-odds in the other. Returns the number of voxels compared.
+std::size_t checkVoxelsIn(const octomap::OcTree& from, const octomap::OcTree& in) {
+  std::size_t voxels = 0;
+  std::size_t mismatches = 0;
+  for (auto it = from.begin_leafs(); it != from.end_leafs(); ++it) {
+    const unsigned side = 1U << (from.getTreeDepth() - it.getDepth());
+    const octomap::OcTreeKey corner = from.adjustKeyAtDepth(it.getKey(), it.getDepth());
+    const octomap::OcTreeKey base(static_cast<octomap::key_type>(corner[0] - side / 2 * (side > 1)),
+                                  static_cast<octomap::key_type>(corner[1] - side / 2 * (side > 1)),
+                                  static_cast<octomap::key_type>(corner[2] - side / 2 * (side > 1)));
+    for (unsigned x = 0; x < side; ++x) {
+      for (unsigned y = 0; y < side; ++y) {
+        for (unsigned z = 0; z < side; ++z) {
+          const octomap::OcTreeKey key(static_cast<octomap::key_type>(base[0] + x),
+                                       static_cast<octomap::key_type>(base[1] + y),
+                                       static_cast<octomap::key_type>(base[2] + z));
+          const octomap::OcTreeNode* other = in.search(key);
+          ++voxels;
+          if (other == nullptr || std::abs(other->getLogOdds() - it->getLogOdds()) > 1e-5F) ++mismatches;
+        }
+      }
+    }
+  }
+  CHECK(mismatches == 0);
+  return voxels;
+}
+
+// Every inner node holds the largest log-odds of its children, as updateInnerOccupancy leaves it.
+std::size_t innerNodesOutOfDate(const octomap::OcTree& tree) {
+  std::size_t wrong = 0;
+  for (auto it = tree.begin_tree(); it != tree.end_tree(); ++it) {
+    if (!tree.nodeHasChildren(&*it)) continue;
+    if (it->getLogOdds() != it->getMaxChildLogOdds()) ++wrong;
+  }
+  return wrong;
+}
+
+void checkSameAsOctomap(double resolution, double max_range, bool exact_rays) {
+  const std::vector<Scan> scans = roomScans();
+  MapConfig config;
+  config.cell_size = resolution;
+  config.max_range = max_range;
+  config.exact_rays = exact_rays;
+  Map map(config);
+  for (const Scan& scan : scans) map.insertIntoOctree(scan);
+  const octomap::OcTree reference = octomapReference(scans, resolution, max_range, !exact_rays);
+  const std::size_t ours = checkVoxelsIn(map.octree(), reference);
+  const std::size_t theirs = checkVoxelsIn(reference, map.octree());
+  CHECK(ours == theirs);
+  CHECK(ours > 10000);
+  CHECK(innerNodesOutOfDate(map.octree()) == 0);
+  std::size_t saturated = 0;
+  for (auto it = map.octree().begin_leafs(); it != map.octree().end_leafs(); ++it) {
+    saturated += it->getLogOdds() <= map.octree().getClampingThresMinLog() ? 1 : 0;
+  }
+  CHECK(saturated > 0);  // the second round reaches the clamping bound and its early abort
+}
+
+}  // namespace
+
+TEST_CASE("OcTree update: one ray per end voxel equals OctoMap's discretized insertPointCloud voxel for voxel") {
+  checkSameAsOctomap(0.1, -1.0, false);
+  checkSameAsOctomap(0.07, 2.2, false);
+}
+
+TEST_CASE("OcTree update: exact rays equal OctoMap's per-point insertPointCloud voxel for voxel") {
+  checkSameAsOctomap(0.1, -1.0, true);
+  checkSameAsOctomap(0.07, 2.2, true);
+}
+
+TEST_CASE("OcTree update: scans added to a pruned tree expand only the nodes they change") {
+  const std::vector<Scan> scans = roomScans();
+  MapConfig config;
+  config.cell_size = 0.1;
+  Map map(config);
+  for (std::size_t k = 0; k < 4; ++k) map.insertIntoOctree(scans[k]);
+  map.octree().prune();
+  for (std::size_t k = 4; k < scans.size(); ++k) map.insertIntoOctree(scans[k]);
+  const octomap::OcTree reference = octomapReference(scans, 0.1, -1.0, true);
+  checkVoxelsIn(map.octree(), reference);
+  checkVoxelsIn(reference, map.octree());
+  CHECK(innerNodesOutOfDate(map.octree()) == 0);
+}
