@@ -15,6 +15,7 @@ first with `mlmap register` from their .pose files), detects planes (2 threads) 
 input point (`mlmap label`, input order). Per marked surface the table gives
   share   the share of its points on its largest patch,
   n10     the patches that hold >= 10 % of its points,
+  joins   the other marked surfaces with >= 10 % of their points on that same patch,
   rms     the RMS of its points to that patch's plane (planes JSON) / to their own least-squares plane, cm;
 and per scene the points on patches outside every marked surface ("unmarked"). With --peers,
 CGAL's efficient RANSAC (--eps 0.03 --angle 20 --min-support 500, as bench/planes_bench.py)
@@ -104,11 +105,14 @@ def score(labels, owner, points, planes, annotation):
         own = real_annotations.rms_to_plane(points[mine], normal, d)
         ids, counts = np.unique(labels[mine & (labels >= 0)], return_counts=True)
         if count == 0 or len(ids) == 0:
-            rows.append(dict(share=0.0, n10=0, rms=float("nan"), own=own, points=count))
+            rows.append(dict(share=0.0, n10=0, joined=0, rms=float("nan"), own=own, points=count))
             continue
         best = ids[np.argmax(counts)]
         n, off = planes[best]
-        rows.append(dict(share=counts.max() / count, n10=int((counts >= 0.1 * count).sum()),
+        # Other marked surfaces with >= 10 % of their points on this patch: surfaces it joins.
+        joined = sum(1 for j in range(len(annotation["surfaces"])) if j != k and
+                     np.sum((owner == j) & (labels == best)) >= 0.1 * max(np.sum(owner == j), 1))
+        rows.append(dict(share=counts.max() / count, n10=int((counts >= 0.1 * count).sum()), joined=joined,
                          rms=real_annotations.rms_to_plane(points[mine], n, off), own=own, points=count))
     on_patch = labels >= 0
     unmarked = on_patch & (owner < 0)
@@ -151,16 +155,17 @@ def run_cgal(peers, folder, points):
 
 def cell_text(row):
     if row is None:
-        return "- | - | -"
-    rms = "-" if math.isnan(row["rms"]) else f"{100 * row['rms']:.1f}/{100 * row['own']:.1f}"
-    return f"{100 * row['share']:.0f} | {row['n10']} | {rms}"
+        return "- | - | - | -"
+    # The largest patch's plane says nothing about a surface it barely touches.
+    rms = "-" if math.isnan(row["rms"]) or row["n10"] == 0 else f"{100 * row['rms']:.1f}/{100 * row['own']:.1f}"
+    return f"{100 * row['share']:.0f} | {row['n10']} | {row['joined']} | {rms}"
 
 
 def table(scene, annotation, results):
     """Markdown: one line per marked surface, columns per method; then unmarked points and times."""
     methods = list(results)
-    head = "| surface | kind | points | " + " | ".join(f"{m} share % | n10 | rms cm" for m in methods) + " |"
-    lines = [f"#### {scene.name}: {scene.title}", "", head, "|" + "---|" * (3 + 3 * len(methods))]
+    head = "| surface | kind | points | " + " | ".join(f"{m} share % | n10 | joins | rms cm" for m in methods) + " |"
+    lines = [f"#### {scene.name}: {scene.title}", "", head, "|" + "---|" * (3 + 4 * len(methods))]
     for k, surface in enumerate(annotation["surfaces"]):
         points = next(iter(results.values()))["rows"][k]["points"]
         lines.append(f"| {surface['name']} | {surface['kind']} | {points} | " +
@@ -185,24 +190,41 @@ def passed(annotation, rows):
     return f"{good} of {len(rows)}"
 
 
-def picture(points, owner, labels, annotation, out, title):
-    """Top view: the marked surfaces (left) and mlmap's patches at the first cell size (right)."""
+def picture(points, owner, labelled, out, title):
+    """Top and side views of the marked surfaces and of each method's patches, cropped to the marked
+    surfaces; a small palette PNG (the README shows one per scene)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    pick = np.random.default_rng(1).permutation(len(points))[:25000]
-    p, o, l = points[pick], owner[pick], labels[pick]
-    fig, axes = plt.subplots(1, 2, figsize=(8, 3.6))
+    marked = points[owner >= 0]
+    lo, hi = np.quantile(marked, 0.005, axis=0) - 0.3, np.quantile(marked, 0.995, axis=0) + 0.3
+    inside = np.all((points >= lo) & (points <= hi), axis=1)
+    pick = np.flatnonzero(inside)
+    pick = pick[np.random.default_rng(1).permutation(len(pick))[:40000]]
+    panels = [("marked surfaces", owner)] + list(labelled.items())
+    fig, axes = plt.subplots(2, len(panels), figsize=(3.2 * len(panels), 5.2), squeeze=False,
+                             gridspec_kw={"height_ratios": [max(hi[1] - lo[1], 0.5), max(hi[2] - lo[2], 0.5)]})
     colours = plt.get_cmap("tab20")
-    for ax, ids, name in ((axes[0], o, "marked surfaces"), (axes[1], l, "mlmap patches")):
-        ax.scatter(p[ids < 0, 0], p[ids < 0, 1], s=0.1, c="0.8", linewidths=0)
-        for k in np.unique(ids[ids >= 0]):
-            ax.scatter(p[ids == k, 0], p[ids == k, 1], s=0.2, color=colours(k % 20), linewidths=0)
-        ax.set_aspect("equal"), ax.set_title(name, fontsize=8), ax.tick_params(labelsize=6)
-    fig.suptitle(title, fontsize=8)
+    for column, (name, ids) in enumerate(panels):
+        ids = ids[pick]
+        p = points[pick]
+        for row, (i, j) in enumerate(((0, 1), (0, 2))):
+            ax = axes[row, column]
+            ax.scatter(p[ids < 0, i], p[ids < 0, j], s=0.3, c="0.82", linewidths=0)
+            for k in np.unique(ids[ids >= 0]):
+                ax.scatter(p[ids == k, i], p[ids == k, j], s=0.6, color=colours(k % 20), linewidths=0)
+            ax.set_xlim(lo[i], hi[i]), ax.set_ylim(lo[j], hi[j]), ax.set_aspect("equal")
+            ax.tick_params(labelsize=5)
+            ax.set_title(f"{name}: {'top' if row == 0 else 'side'} ({'xyz'[i]}{'xyz'[j]})", fontsize=6)
+    fig.suptitle(title, fontsize=7)
     fig.tight_layout()
-    fig.savefig(out, dpi=64)
+    fig.savefig(out, dpi=72)
     plt.close(fig)
+    try:  # a palette image is a third of the size
+        from PIL import Image
+        Image.open(out).convert("RGB").quantize(colors=48).save(out, optimize=True)
+    except ImportError:
+        pass
 
 
 def main():
@@ -246,25 +268,26 @@ def main():
             registered = os.path.join(folder, "registered.tum")
             run([mlmap, "-q", "register", "-o", registered, "--poses", pose_file] + files)
             pose_file = registered
-        results, first_labels = {}, None
+        results, labelled = {}, {}
         for cell in cells:
             points, labels, planes, times = run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features)
             if len(labels) != len(world):
                 raise SystemExit(f"real_data: {name}: mlmap label wrote {len(labels)} points for {len(world)} input points")
             rows, extra = score(labels, owner, points, planes, annotation)
             results[f"mlmap {cell:g}"] = dict(rows=rows, extra=extra, times=times)
-            first_labels = labels if first_labels is None else first_labels
+            labelled[f"mlmap {cell:g} m"] = labels
         if cgal:
             labels, planes, times = run_cgal(a.peers, folder, world)
             rows, extra = score(labels, owner, world, planes, annotation)
             results["CGAL"] = dict(rows=rows, extra=extra, times=times)
+            labelled["CGAL"] = labels
         text = table(scene, annotation, results)
         print(text, flush=True)
         report.append(text)
         if a.docs:
             os.makedirs(a.docs, exist_ok=True)
-            picture(world, owner, first_labels, annotation, os.path.join(a.docs, f"real-{name}.png"),
-                    f"{name}: marked surfaces and mlmap's patches at {cells[0]:g} m (top view)")
+            picture(world, owner, labelled, os.path.join(a.docs, f"real-{name}.png"),
+                    f"{name}: {scene.title}; grey: no surface / no patch")
     if report:
         os.makedirs(a.out, exist_ok=True)
         open(os.path.join(a.out, "real_data.md"), "w").write("\n".join(report))
