@@ -130,7 +130,8 @@ def run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features
     run([mlmap, "-q", "planes", tag + ".mlmap", "--threads", "2", "-o", tag + ".planes.mlmap", "--json", tag + ".planes.json"])
     planes_json = json.load(open(tag + ".planes.json"))
     label = [mlmap, "-q", "label", tag + ".planes.mlmap", "-o", tag + ".labels.xyz"] + posed
-    label += [o for o in up_options if "--up" in features["label"]] if up_options else []
+    if "--up" in features["label"]:
+        label += up_options  # so that label places the points in the frame of the map's planes
     if "--max-range" in features["label"]:
         label += ["--max-range", "1000"]  # every input point keeps its line: labels come in input order
     if "--min-range" in features["label"]:
