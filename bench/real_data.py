@@ -1,43 +1,233 @@
 #!/usr/bin/python3
-"""eRMSM on the real scans of ../shared/data (recorded by others, no plane ground truth):
-what a map and its planes look like outside the simulator.
+"""Plane detection on the real scans of ../shared/data, scored against surfaces marked by hand.
 
     /usr/bin/python3 bench/real_data.py [--build build] [--data ../shared/data] [--out out/real]
+        [--cells 0.05,0.1] [--peers /work/build-peers] [--only NAME,...] [--docs docs]
 
-For every data set and cell size: build the block layer (`--no-octree`; the 3DTK scans
-registered with `--register` from their own start poses), detect planes, and print the
-blocks and how many of them are vertical, the patches, their surface by class
-and the detection time (2 threads). Data sets that are not there are skipped with a message.
+Every scene of bench/real_clouds.py (3DTK's three scans, OctoMap's scan.dat, Bobkov's room 2,
+PCL's office1 and two room scans, plane_seg's two stair scans) has an annotation file
+bench/annotations/NAME.json: the floor, ceiling, walls, table tops, stair treads and risers a
+person sees there, each a region and the plane it lies on (bench/real_annotations.py; made by
+looking at views of the points and fitting planes in chosen regions, never from mlmap's output).
+
+Per scene and cell size mlmap builds the block layer (--no-octree; 3DTK's scans registered
+first with `mlmap register` from their .pose files), detects planes (2 threads) and labels every
+input point (`mlmap label`, input order). Per marked surface the table gives
+  share   the share of its points on its largest patch,
+  n10     the patches that hold >= 10 % of its points,
+  joins   the other marked surfaces with >= 10 % of their points on that same patch,
+  rms     the RMS of its points to that patch's plane (planes JSON) / to their own least-squares plane, cm;
+and per scene the points on patches outside every marked surface ("unmarked"). With --peers,
+CGAL's efficient RANSAC (--eps 0.03 --angle 20 --min-support 500, as bench/planes_bench.py)
+runs on the same points (annotation frame) and is scored the same way. Times: mlmap's
+detection (planes JSON total_s) and build, CGAL's normals + detection.
+
+y-up scans (office1) are passed with `--up y` when `mlmap build --help` lists it, otherwise as
+z-up scans (the benchmark turns them itself). Scans go to mlmap as .xyz files in their sensor
+frame with a TUM pose file where the sensor position is known (so that `label` knows the
+beams' origins), as world points otherwise. Missing data, annotations or peers are skipped
+with a message. Writes out/real/NAME/*, out/real/real_data.md and, with --docs, one small
+picture per scene (docs/real-NAME.png).
 """
-import argparse, bz2, collections, json, os, subprocess
+import argparse, json, math, os, re, subprocess, sys, time
+
+import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+import real_annotations  # noqa: E402
+import real_clouds  # noqa: E402
+
+CGAL_ARGS = ["--eps", "0.03", "--angle", "20", "--min-support", "500", "--max-planes", "60"]
 
 
 def run(cmd):
-    return subprocess.run(cmd, check=True, capture_output=True, text=True)
+    started = time.perf_counter()
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed ({done.returncode}):\n{done.stderr.strip()}")
+    return done, time.perf_counter() - started
 
 
-def data_sets(data, out):
-    """(name, scans, build options, what it is) for the data sets present."""
-    sets = []
-    threedtk = os.path.join(data, "3dtk_dat_3scans")
-    if os.path.isdir(threedtk):
-        scans = [os.path.join(threedtk, f"scan00{k}.3d") for k in range(3)]
-        sets.append(("3dtk", scans, ["--register"], "3DTK's example: 3 scans of 81,360 points each, registered from their start poses"))
-    octomap = os.path.join(data, "octomap_share_samples", "scan.dat.bz2")
-    if os.path.exists(octomap):
-        xyz = os.path.join(out, "fr079_scan.xyz")
-        if not os.path.exists(xyz):
-            with bz2.open(octomap, "rt") as packed, open(xyz + ".part", "w") as unpacked:
-                unpacked.write(packed.read())
-            os.replace(xyz + ".part", xyz)
-        sets.append(("fr079", [xyz], [], "OctoMap's scan.dat: one 3D scan of 88,206 points over 27 x 32 x 11 m"))
-    bobkov = os.path.join(data, "bobkov_office_labels", "room2_gt_fine.pcd")
-    if os.path.exists(bobkov):
-        sets.append(("office", [bobkov], [], "Bobkov et al. room 2: a registered mobile-scanner cloud of 123,692 points, z 1.5-3.4 m"))
-    return sets
+def options_of(mlmap, command):
+    """The long options `mlmap COMMAND --help` lists."""
+    text = subprocess.run([mlmap, command, "--help"], capture_output=True, text=True).stdout
+    return set(re.findall(r"(--[a-z][a-z-]*)", text))
+
+
+def quaternion(r):
+    """(qx, qy, qz, qw) of a rotation matrix."""
+    w = math.sqrt(max(0.0, 1.0 + r[0, 0] + r[1, 1] + r[2, 2])) / 2
+    x = math.copysign(math.sqrt(max(0.0, 1.0 + r[0, 0] - r[1, 1] - r[2, 2])) / 2, r[2, 1] - r[1, 2])
+    y = math.copysign(math.sqrt(max(0.0, 1.0 - r[0, 0] + r[1, 1] - r[2, 2])) / 2, r[0, 2] - r[2, 0])
+    z = math.copysign(math.sqrt(max(0.0, 1.0 - r[0, 0] - r[1, 1] + r[2, 2])) / 2, r[1, 0] - r[0, 1])
+    return x, y, z, w
+
+
+def write_inputs(scene, folder, up_option):
+    """The .xyz files and pose file (or None) mlmap is given, and the options it needs for the up axis."""
+    turn = np.eye(3)
+    options = []
+    if scene.up == "y":
+        if up_option:
+            options = ["--up", "y"]
+        else:
+            turn = real_clouds.Y_UP_TO_Z_UP
+    files, poses = [], []
+    for k, (points, r, t) in enumerate(scene.scans):
+        path = os.path.join(folder, f"scan{k:03d}.xyz")
+        if scene.sensor_known:
+            np.savetxt(path, points, fmt="%.5f")
+            qx, qy, qz, qw = quaternion(turn @ r)
+            tt = turn @ t
+            poses.append(f"{k} {tt[0]:.6f} {tt[1]:.6f} {tt[2]:.6f} {qx:.9f} {qy:.9f} {qz:.9f} {qw:.9f}")
+        else:
+            np.savetxt(path, (points @ r.T + t) @ turn.T, fmt="%.5f")
+        files.append(path)
+    pose_file = None
+    if poses:
+        pose_file = os.path.join(folder, "poses.tum")
+        open(pose_file, "w").write("\n".join(poses) + "\n")
+    return files, pose_file, options
+
+
+def score(labels, owner, points, planes, annotation):
+    """Per surface (share, n10, rms to the largest patch's plane, own rms, points) and the unmarked points.
+
+    labels: per point the patch id (<0 none); planes: id -> (normal, offset) in the frame of `points`.
+    """
+    rows = []
+    for k, surface in enumerate(annotation["surfaces"]):
+        mine = owner == k
+        count = int(mine.sum())
+        normal, d = real_annotations.fit_plane(points[mine], trim=0) if count >= 3 else (np.zeros(3), 0.0)
+        own = real_annotations.rms_to_plane(points[mine], normal, d)
+        ids, counts = np.unique(labels[mine & (labels >= 0)], return_counts=True)
+        if count == 0 or len(ids) == 0:
+            rows.append(dict(share=0.0, n10=0, joined=0, rms=float("nan"), own=own, points=count))
+            continue
+        best = ids[np.argmax(counts)]
+        n, off = planes[best]
+        # Other marked surfaces with >= 10 % of their points on this patch: surfaces it joins.
+        joined = sum(1 for j in range(len(annotation["surfaces"])) if j != k and
+                     np.sum((owner == j) & (labels == best)) >= 0.1 * max(np.sum(owner == j), 1))
+        rows.append(dict(share=counts.max() / count, n10=int((counts >= 0.1 * count).sum()), joined=joined,
+                         rms=real_annotations.rms_to_plane(points[mine], n, off), own=own, points=count))
+    on_patch = labels >= 0
+    unmarked = on_patch & (owner < 0)
+    # A patch lies on no marked surface when most of its points are outside every one.
+    stray = [p for p in np.unique(labels[on_patch]) if np.mean(owner[labels == p] < 0) > 0.5]
+    return rows, dict(on_patch=int(on_patch.sum()), unmarked=int(unmarked.sum()), patches=len(np.unique(labels[on_patch])),
+                      stray_patches=len(stray), stray_points=int(np.isin(labels, stray).sum()))
+
+
+def run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features):
+    tag = os.path.join(folder, f"cell{cell:g}")
+    posed = ["--poses", pose_file] if pose_file else []
+    build = [mlmap, "-q", "build", "-o", tag + ".mlmap", "--cell-size", str(cell), "--no-octree"] + posed + up_options
+    _, build_s = run(build + files)
+    run([mlmap, "-q", "planes", tag + ".mlmap", "--threads", "2", "-o", tag + ".planes.mlmap", "--json", tag + ".planes.json"])
+    planes_json = json.load(open(tag + ".planes.json"))
+    label = [mlmap, "-q", "label", tag + ".planes.mlmap", "-o", tag + ".labels.xyz"] + posed
+    if "--up" in features["label"]:
+        label += up_options  # so that label places the points in the frame of the map's planes
+    if "--max-range" in features["label"]:
+        label += ["--max-range", "1000"]  # every input point keeps its line: labels come in input order
+    if "--min-range" in features["label"]:
+        label += ["--min-range", "0"]
+    run(label + files)
+    table = np.loadtxt(tag + ".labels.xyz", dtype=np.float64, ndmin=2)
+    planes = {p["id"]: (np.array(p["normal"]), p["offset"]) for p in planes_json["planes"]}
+    return table[:, :3], table[:, 3].astype(int), planes, dict(build_s=build_s, detect_s=planes_json["timings"]["total_s"])
+
+
+def run_cgal(peers, folder, points):
+    program = os.path.join(peers, "cgal_ransac")
+    cloud = os.path.join(folder, "world.xyz")
+    np.savetxt(cloud, points, fmt="%.5f")
+    done, _ = run([program, cloud, "--labels", os.path.join(folder, "cgal.labels")] + CGAL_ARGS)
+    result = json.loads(done.stdout)
+    labels = np.loadtxt(os.path.join(folder, "cgal.labels"), dtype=int)
+    planes = {k: (np.array(p["normal"]), p["d"]) for k, p in enumerate(result["planes"])}
+    seconds = result["seconds"]
+    return labels, planes, dict(detect_s=seconds.get("normals", 0.0) + seconds["detect"])
+
+
+def cell_text(row):
+    if row is None:
+        return "- | - | - | -"
+    # The largest patch's plane says nothing about a surface it barely touches.
+    rms = "-" if math.isnan(row["rms"]) or row["n10"] == 0 else f"{100 * row['rms']:.1f}/{100 * row['own']:.1f}"
+    return f"{100 * row['share']:.0f} | {row['n10']} | {row['joined']} | {rms}"
+
+
+def table(scene, annotation, results):
+    """Markdown: one line per marked surface, columns per method; then unmarked points and times."""
+    methods = list(results)
+    head = "| surface | kind | points | " + " | ".join(f"{m} share % | n10 | joins | rms cm" for m in methods) + " |"
+    lines = [f"#### {scene.name}: {scene.title}", "", head, "|" + "---|" * (3 + 4 * len(methods))]
+    for k, surface in enumerate(annotation["surfaces"]):
+        points = next(iter(results.values()))["rows"][k]["points"]
+        lines.append(f"| {surface['name']} | {surface['kind']} | {points} | " +
+                     " | ".join(cell_text(results[m]["rows"][k]) for m in methods) + " |")
+    lines.append("")
+    lines.append("| | " + " | ".join(methods) + " |")
+    lines.append("|---|" + "---|" * len(methods))
+    lines.append("| surfaces found: >= 90 % (walls, floor, ceiling) or >= 70 % (the others) on a patch that joins no other | " + " | ".join(
+        f"{passed(annotation, results[m]['rows'])}" for m in methods) + " |")
+    lines.append("| patches / on no marked surface | " + " | ".join(
+        f"{results[m]['extra']['patches']} / {results[m]['extra']['stray_patches']}" for m in methods) + " |")
+    lines.append("| points on patches / outside marked surfaces | " + " | ".join(
+        f"{results[m]['extra']['on_patch']} / {results[m]['extra']['unmarked']}" for m in methods) + " |")
+    lines.append("| detection s (mlmap: planes, 2 threads; CGAL: normals + RANSAC) | " + " | ".join(
+        f"{results[m]['times']['detect_s']:.2f}" for m in methods) + " |")
+    lines.append("| map build s (mlmap build --no-octree) | " + " | ".join(
+        f"{results[m]['times']['build_s']:.2f}" if "build_s" in results[m]["times"] else "-" for m in methods) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def passed(annotation, rows):
+    good = sum(1 for s, r in zip(annotation["surfaces"], rows)
+               if r["share"] >= (0.9 if s["kind"] in ("floor", "ceiling", "wall") else 0.7) and r["joined"] == 0)
+    return f"{good} of {len(rows)}"
+
+
+def picture(points, owner, labelled, out, title):
+    """Top and side views of the marked surfaces and of each method's patches, cropped to the marked
+    surfaces; a small palette PNG (the README shows one per scene)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    marked = points[owner >= 0]
+    lo, hi = np.quantile(marked, 0.005, axis=0) - 0.3, np.quantile(marked, 0.995, axis=0) + 0.3
+    inside = np.all((points >= lo) & (points <= hi), axis=1)
+    pick = np.flatnonzero(inside)
+    pick = pick[np.random.default_rng(1).permutation(len(pick))[:40000]]
+    panels = [("marked surfaces", owner)] + list(labelled.items())
+    fig, axes = plt.subplots(2, len(panels), figsize=(3.2 * len(panels), 5.2), squeeze=False,
+                             gridspec_kw={"height_ratios": [max(hi[1] - lo[1], 0.5), max(hi[2] - lo[2], 0.5)]})
+    colours = plt.get_cmap("tab20")
+    for column, (name, ids) in enumerate(panels):
+        ids = ids[pick]
+        p = points[pick]
+        for row, (i, j) in enumerate(((0, 1), (0, 2))):
+            ax = axes[row, column]
+            ax.scatter(p[ids < 0, i], p[ids < 0, j], s=0.3, c="0.82", linewidths=0)
+            for k in np.unique(ids[ids >= 0]):
+                ax.scatter(p[ids == k, i], p[ids == k, j], s=0.6, color=colours(k % 20), linewidths=0)
+            ax.set_xlim(lo[i], hi[i]), ax.set_ylim(lo[j], hi[j]), ax.set_aspect("equal")
+            ax.tick_params(labelsize=5)
+            ax.set_title(f"{name}: {'top' if row == 0 else 'side'} ({'xyz'[i]}{'xyz'[j]})", fontsize=6)
+    fig.suptitle(title, fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out, dpi=72)
+    plt.close(fig)
+    try:  # a palette image is a third of the size
+        from PIL import Image
+        Image.open(out).convert("RGB").quantize(colors=48).save(out, optimize=True)
+    except ImportError:
+        pass
 
 
 def main():
@@ -46,39 +236,68 @@ def main():
     ap.add_argument("--data", default=os.path.join(os.path.dirname(ROOT), "shared", "data"))
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "real"))
     ap.add_argument("--cells", default="0.05,0.1")
+    ap.add_argument("--peers", help="build directory of ../shared/peers (cgal_ransac); optional")
+    ap.add_argument("--only", help="comma-separated scene names")
+    ap.add_argument("--docs", help="write one picture per scene here (docs/real-NAME.png)")
     a = ap.parse_args()
     if not os.path.isdir(a.data):
         print(f"real_data: skipped, no data directory at {a.data}")
         return
-    os.makedirs(a.out, exist_ok=True)
     mlmap = os.path.join(a.build, "mlmap")
     if not os.access(mlmap, os.X_OK):
         raise SystemExit(f"real_data: no mlmap CLI at {mlmap} (build it first, or give --build)")
-    sets = data_sets(a.data, a.out)
-    if not sets:
-        print(f"real_data: skipped, none of the data sets is in {a.data}")
-        return
-    print("| data | cell m | blocks | vertical | patches | m² by class | detect s |")
-    print("|---|---|---|---|---|---|---|")
-    for name, scans, options, _ in sets:
-        for cell in (float(c) for c in a.cells.split(",")):
-            tag = f"{name}-{cell:g}"
-            map_file, planes_file = os.path.join(a.out, tag + ".mlmap"), os.path.join(a.out, tag + ".planes.json")
-            run([mlmap, "-q", "build", "-o", map_file, "--cell-size", str(cell), "--no-octree"] + options + scans)
-            run([mlmap, "-q", "planes", map_file, "--threads", "2", "--json", planes_file])
-            planes = json.load(open(planes_file))
-            counts = json.loads(run([mlmap, "info", "--json", map_file]).stdout)["blocks"]
-            blocks, vertical = counts["total"], counts["vertical"]
-            area = collections.defaultdict(float)
-            for plane in planes["planes"]:
-                area[plane["label"]] += plane["area"]
-            by_class = ", ".join(f"{label} {value:.1f}" for label, value in sorted(area.items(), key=lambda item: -item[1]))
-            print(f"| {name} | {cell:g} | {blocks} | "
-                  f"{100.0 * vertical / max(blocks, 1):.1f} % | {len(planes['planes'])} | {by_class} | "
-                  f"{planes['timings']['total_s']:.3f} |")
-    print()
-    for name, _, _, what in sets:
-        print(f"{name}: {what}")
+    cgal = a.peers and os.access(os.path.join(a.peers, "cgal_ransac"), os.X_OK)
+    if a.peers and not cgal:
+        print(f"real_data: no cgal_ransac in {a.peers}, CGAL skipped")
+    features = {c: options_of(mlmap, c) for c in ("build", "label", "register")}
+    cells = [float(c) for c in a.cells.split(",")]
+    report = []
+    for name, scene, why in real_clouds.scenes(a.data):
+        if a.only and name not in a.only.split(","):
+            continue
+        if scene is None:
+            print(f"real_data: {name} skipped ({why})")
+            continue
+        annotation = real_annotations.load(name)
+        if annotation is None:
+            print(f"real_data: {name} skipped (no bench/annotations/{name}.json)")
+            continue
+        folder = os.path.join(a.out, name)
+        os.makedirs(folder, exist_ok=True)
+        world = scene.world()
+        owner = real_annotations.memberships(world, annotation)
+        files, pose_file, up_options = write_inputs(scene, folder, "--up" in features["build"])
+        if scene.register:
+            registered = os.path.join(folder, "registered.tum")
+            run([mlmap, "-q", "register", "-o", registered, "--poses", pose_file] + files)
+            pose_file = registered
+        results, labelled = {}, {}
+        for cell in cells:
+            points, labels, planes, times = run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features)
+            if len(labels) != len(world):
+                raise SystemExit(f"real_data: {name}: mlmap label wrote {len(labels)} points for {len(world)} input points")
+            rows, extra = score(labels, owner, points, planes, annotation)
+            results[f"mlmap {cell:g}"] = dict(rows=rows, extra=extra, times=times)
+            labelled[f"mlmap {cell:g} m"] = labels
+        if cgal:
+            labels, planes, times = run_cgal(a.peers, folder, world)
+            rows, extra = score(labels, owner, world, planes, annotation)
+            results["CGAL"] = dict(rows=rows, extra=extra, times=times)
+            labelled["CGAL"] = labels
+        text = table(scene, annotation, results)
+        print(text, flush=True)
+        report.append(text)
+        if a.docs:
+            os.makedirs(a.docs, exist_ok=True)
+            picture(world, owner, labelled, os.path.join(a.docs, f"real-{name}.png"),
+                    f"{name}: {scene.title}; grey: no surface / no patch")
+    if report:
+        os.makedirs(a.out, exist_ok=True)
+        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+        head = (f"`{' '.join(['bench/real_data.py'] + sys.argv[1:])}` at {commit or '?'}, "
+                f"{time.strftime('%Y-%m-%d %H:%M')}, load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores\n")
+        print(head)
+        open(os.path.join(a.out, "real_data.md"), "w").write(head + "\n" + "\n".join(report))
 
 
 if __name__ == "__main__":

@@ -1,0 +1,190 @@
+"""The hand-made surface annotations of the real scans (bench/annotations/NAME.json) and the tools
+used to make and check them.
+
+An annotation file lists the surfaces a person sees in one scene, in the frame of
+bench/real_clouds.py (the data's own poses, z up):
+
+    {"scene": "room_scan1", "frame": "...", "notes": "...",
+     "surfaces": [{"name": "floor", "kind": "floor",
+                   "region": {"box": [[x0, y0, z0], [x1, y1, z1]]}      (or "polygon": [[x, y], ...], "z": [z0, z1]),
+                   "exclude": [{"box": ...}, ...]                          (optional: holes in the region),
+                   "plane": [nx, ny, nz, d],  "tolerance": 0.05}]}
+
+A point belongs to a surface when it lies in the region, in none of its exclusions, and within
+the tolerance of the plane (n·p + d = 0). Kinds: floor, ceiling, wall, table (desk/table/sideboard
+tops), tread, riser, step (tilted block faces), other.
+
+The planes were fitted with numpy (fit_plane below) to the points of regions chosen by looking at
+top and side views and slices (views below); nothing here reads mlmap's output.
+
+    /usr/bin/python3 bench/real_annotations.py views NAME [--z0 Z --z1 Z] [--box x0,y0,z0,x1,y1,z1]
+    /usr/bin/python3 bench/real_annotations.py fit NAME x0,y0,z0,x1,y1,z1
+    /usr/bin/python3 bench/real_annotations.py check NAME
+"""
+import argparse, json, os, sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+ANNOTATIONS = os.path.join(HERE, "annotations")
+KINDS = ("floor", "ceiling", "wall", "table", "tread", "riser", "step", "other")
+
+
+def _in_region(points, region):
+    if "box" in region:
+        lo, hi = np.array(region["box"][0]), np.array(region["box"][1])
+        return np.all((points >= lo) & (points <= hi), axis=1)
+    from matplotlib.path import Path
+    z0, z1 = region["z"]
+    inside = Path(np.array(region["polygon"])).contains_points(points[:, :2])
+    return inside & (points[:, 2] >= z0) & (points[:, 2] <= z1)
+
+
+def surface_mask(points, surface):
+    """Points of one annotated surface: in its region, out of its exclusions, near its plane."""
+    mask = _in_region(points, surface["region"])
+    for hole in surface.get("exclude", []):
+        mask &= ~_in_region(points, hole)
+    plane = np.array(surface["plane"])
+    return mask & (np.abs(points @ plane[:3] + plane[3]) <= surface["tolerance"])
+
+
+def load(name):
+    path = os.path.join(ANNOTATIONS, name + ".json")
+    if not os.path.exists(path):
+        return None
+    annotation = json.load(open(path))
+    for surface in annotation["surfaces"]:
+        if surface["kind"] not in KINDS:
+            raise ValueError(f"{path}: surface {surface['name']}: kind {surface['kind']} is not one of {KINDS}")
+    return annotation
+
+
+def memberships(points, annotation):
+    """Per point the index of its surface (-1 none); a point in two surfaces goes to the nearer plane."""
+    owner, distance = np.full(len(points), -1), np.full(len(points), np.inf)
+    for k, surface in enumerate(annotation["surfaces"]):
+        plane = np.array(surface["plane"])
+        d = np.abs(points @ plane[:3] + plane[3])
+        take = surface_mask(points, surface) & (d < distance)
+        owner[take], distance[take] = k, d[take]
+    return owner
+
+
+def fit_plane(points, trim=3, keep=0.9):
+    """Least-squares plane (n, d) with n·p + d = 0, refitted `trim` times on the `keep` share nearest to it."""
+    chosen = points
+    for _ in range(trim + 1):
+        centre = chosen.mean(axis=0)
+        normal = np.linalg.svd(chosen - centre, full_matrices=False)[2][2]
+        if abs(normal[2]) > 0.7 and normal[2] < 0:
+            normal = -normal
+        elif abs(normal[2]) <= 0.7 and normal @ np.array([1.0, 1.0, 0.0]) < 0:
+            normal = -normal
+        d = -normal @ centre
+        residual = np.abs(points @ normal + d)
+        chosen = points[residual <= np.quantile(residual, keep)] if len(points) > 10 else points
+    return normal, float(d)
+
+
+def rms_to_plane(points, normal, d):
+    return float(np.sqrt(np.mean((points @ normal + d) ** 2))) if len(points) else float("nan")
+
+
+# ------------------------------------------------------------------ the tools used by hand
+
+def _scene(name, data):
+    sys.path.insert(0, HERE)
+    import real_clouds
+    for scene_name, scene, why in real_clouds.scenes(data):
+        if scene_name == name:
+            if scene is None:
+                raise SystemExit(f"{name}: {why}")
+            return scene
+    raise SystemExit(f"no scene {name}")
+
+
+def views(points, out, title, box=None):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    if box is not None:
+        points = points[np.all((points >= box[:3]) & (points <= box[3:]), axis=1)]
+    fig, axes = plt.subplots(1, 3, figsize=(21, 7))
+    for ax, (i, j, c) in zip(axes, [(0, 1, 2), (0, 2, 1), (1, 2, 0)]):
+        order = np.argsort(points[:, c])
+        ax.scatter(points[order, i], points[order, j], c=points[order, c], s=0.3, cmap="viridis")
+        ax.set_xlabel("xyz"[i]), ax.set_ylabel("xyz"[j]), ax.set_aspect("equal"), ax.grid(True, alpha=0.4)
+        ax.set_title(f"{title}: {'xyz'[i]}{'xyz'[j]} coloured by {'xyz'[c]}")
+        ax.minorticks_on(), ax.grid(True, which="minor", alpha=0.15)
+    fig.tight_layout()
+    fig.savefig(out, dpi=70)
+    plt.close(fig)
+
+
+def check_picture(points, annotation, out, title, dpi=60, max_points=60000):
+    """Top view and side view of a scene with each annotated surface in its own colour."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    owner = memberships(points, annotation)
+    rng = np.random.default_rng(1)
+    pick = rng.permutation(len(points))[:max_points]
+    p, o = points[pick], owner[pick]
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5))
+    colours = plt.get_cmap("tab20")
+    for ax, (i, j) in zip(axes, [(0, 1), (0, 2)]):
+        ax.scatter(p[o < 0, i], p[o < 0, j], s=0.2, c="0.8")
+        for k in np.unique(o[o >= 0]):
+            ax.scatter(p[o == k, i], p[o == k, j], s=0.3, color=colours(k % 20))
+        ax.set_aspect("equal"), ax.set_xlabel("xyz"[i]), ax.set_ylabel("xyz"[j])
+    for k, surface in enumerate(annotation["surfaces"]):
+        where = points[owner == k]
+        if len(where):
+            c = np.median(where, axis=0)
+            axes[0].annotate(surface["name"], (c[0], c[1]), fontsize=6)
+            axes[1].annotate(surface["name"], (c[0], c[2]), fontsize=6)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(out, dpi=dpi)
+    plt.close(fig)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("tool", choices=["views", "fit", "check"])
+    ap.add_argument("name")
+    ap.add_argument("box", nargs="?")
+    ap.add_argument("--data", default=os.path.join(os.path.dirname(ROOT), "shared", "data"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "annotate"))
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    points = _scene(a.name, a.data).world()
+    box = np.array([float(v) for v in a.box.split(",")]) if a.box else None
+    if a.tool == "views":
+        out = os.path.join(a.out, f"{a.name}_views{'_' + a.box.replace(',', '_') if a.box else ''}.png")
+        views(points, out, a.name, box)
+        print(out, len(points), "points; extent", points.min(axis=0).round(2), points.max(axis=0).round(2))
+    elif a.tool == "fit":
+        inside = points[np.all((points >= box[:3]) & (points <= box[3:]), axis=1)]
+        normal, d = fit_plane(inside)
+        residual = inside @ normal + d
+        near = np.abs(residual) < 0.05
+        print(f"{len(inside)} points, plane [{normal[0]:.4f}, {normal[1]:.4f}, {normal[2]:.4f}, {d:.4f}], "
+              f"rms {rms_to_plane(inside, normal, d):.4f}, within 5 cm {near.mean():.2f} (rms there {np.sqrt(np.mean(residual[near] ** 2)):.4f}), "
+              f"median |r| {np.median(np.abs(residual)):.4f}")
+    else:
+        annotation = load(a.name)
+        owner = memberships(points, annotation)
+        for k, surface in enumerate(annotation["surfaces"]):
+            mine = points[owner == k]
+            plane = np.array(surface["plane"])
+            print(f"{surface['name']:>16} {surface['kind']:>8} {len(mine):7d} pts, rms to plane {rms_to_plane(mine, plane[:3], plane[3]):.4f}")
+        out = os.path.join(a.out, f"{a.name}_check.png")
+        check_picture(points, annotation, out, a.name, dpi=90)
+        print(out, f"{(owner >= 0).mean():.2f} of points on a surface")
+
+
+if __name__ == "__main__":
+    main()
