@@ -207,7 +207,8 @@ void Emulator::ptuLoop() {
   try {
     while (!stop_) {
       char chunk[256];
-      const std::size_t got = ptu_->read(chunk, sizeof(chunk), std::chrono::milliseconds(1));
+      // Input ends the wait at once; only an A (await) has to watch the clock.
+      const std::size_t got = ptu_->read(chunk, sizeof(chunk), std::chrono::milliseconds(awaiting ? 1 : 20));
       if (echo_ptu_ && got > 0) ptu_->write(std::string_view(chunk, got));
       pending.append(chunk, got);
       if (pending.size() > 1024) pending.clear();

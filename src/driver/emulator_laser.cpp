@@ -352,10 +352,19 @@ bool Emulator::serveLaserClient() {
       const double now = emulatedSeconds();
       const bool paced = last_frame_real_s < 0.0 ||
                          now / options_.time_scale - last_frame_real_s >= 0.5 * kRevolutionS / options_.time_scale;
-      const bool due = (paced && stream_.active && (stream_.next_revolution + 1) * kRevolutionS <= now) ||
-                       (single_.active && (single_.next_revolution + 1) * kRevolutionS <= now);
+      // Sleep until a command comes in or the next frame is due (emulated seconds), so an
+      // idle or streaming laser costs no polling: a command ends the wait at once.
+      double next_due = 1e300;
+      if (stream_.active) {
+        next_due = static_cast<double>(stream_.next_revolution + 1) * kRevolutionS;
+        if (!paced) next_due = std::max(next_due, (last_frame_real_s + 0.5 * kRevolutionS / options_.time_scale) *
+                                                      options_.time_scale);
+      }
+      if (single_.active) next_due = std::min(next_due, static_cast<double>(single_.next_revolution + 1) * kRevolutionS);
+      const double wait_ms = std::clamp((next_due - now) / options_.time_scale * 1e3, 0.0, 20.0);
       char chunk[512];
-      const std::size_t got = laser_->read(chunk, sizeof(chunk), std::chrono::milliseconds(due ? 0 : 1));
+      const std::size_t got =
+          laser_->read(chunk, sizeof(chunk), std::chrono::milliseconds(static_cast<int>(std::ceil(wait_ms))));
       if (stalled_) continue;
       pending.append(chunk, got);
       if (pending.size() > 4096) pending.clear();  // garbage: drop it
