@@ -95,7 +95,7 @@ TEST_CASE("SCIP §7, §8.11-8.13: checksums as the specification's examples comp
   }
 }
 
-TEST_CASE("SCIP §7, §9: string characters are echoed; too long (0G) or invalid letters (0H) refused") {
+TEST_CASE("SCIP §7, §9: string characters are echoed, too long (0G) or invalid letters (0H) refused") {
   Raw raw;
   const auto vv = raw.ask("VV;probe_1.a+b@c");
   REQUIRE(vv.size() > 2);
@@ -116,7 +116,7 @@ TEST_CASE("SCIP §7, §9: string characters are echoed; too long (0G) or invalid
   CHECK(data[1] == "99b");
 }
 
-TEST_CASE("SCIP §8.1: the MD/MS status table, in its order; §9: short and undefined commands") {
+TEST_CASE("SCIP §8.1: the MD/MS status table, in its order, §9: short and undefined commands") {
   Raw raw;
   CHECK(raw.status("MDx000108001000") == "01");  // starting step non-numeric
   CHECK(raw.status("MD0000x08001000") == "02");  // end step non-numeric
@@ -179,7 +179,7 @@ TEST_CASE("SCIP §8.1: remaining scans in the echo, scan interval honoured, lase
   CHECK(raw.status("GD0400044001") == "10");
 }
 
-TEST_CASE("SCIP §8.1: cluster count 00 is 1; a cluster reports its steps' smallest range") {
+TEST_CASE("SCIP §8.1: cluster count 00 is 1, a cluster reports its steps' smallest range") {
   Raw raw;
   ScipClient client(*raw.device, std::chrono::milliseconds(1000));
   client.connect();
@@ -204,7 +204,7 @@ TEST_CASE("SCIP §8.1: cluster count 00 is 1; a cluster reports its steps' small
   CHECK(not_middle > 0);  // the minimum, not the middle step's range
 }
 
-TEST_CASE("SCIP §8.1-8.2 end to end: GD and MD give the same ranges; ME adds intensities") {
+TEST_CASE("SCIP §8.1-8.2 end to end: GD and MD give the same ranges, ME adds intensities") {
   Raw raw;
   ScipClient client(*raw.device, std::chrono::milliseconds(1000));
   client.connect();
