@@ -79,7 +79,10 @@ void addEmulateCommand(CLI::App& app, Context& context) {
       ->capture_default_str();
   command->add_option("--config", arguments->config, "Mount offsets JSON (as for mlmap scan)")
       ->check(CLI::ExistingFile);
-  command->add_flag("--tcp", arguments->tcp, "Laser on a loopback TCP port instead of a pty");
+  command->add_flag("--tcp", arguments->tcp,
+                    "Laser on a loopback TCP port instead of a pty (any number of clients, one after another)");
+  command->add_flag("--scip11", arguments->options.start_in_scip11,
+                    "Laser starts in SCIP 1.1, like a URG-04LX, until a client sends SCIP2.0");
   command->add_option("--port", arguments->options.tcp_port, "TCP port for --tcp (0: any free)")
       ->capture_default_str();
   command->add_option("--time-scale", arguments->options.time_scale, "Emulated seconds per real second")
@@ -92,7 +95,7 @@ void addEmulateCommand(CLI::App& app, Context& context) {
   command->add_option("--duration", arguments->duration_s, "Stop after this many seconds (0: never)")
       ->capture_default_str();
   command->add_option("--fault-bad-checksum", arguments->options.faults.bad_checksum_frame,
-                      "Corrupt a data line's sum in this MD frame (0-based)");
+                      "Corrupt a data line's sum in this MD/ME data frame (0-based; off unless given)");
   command->add_option("--fault-drop-line", arguments->options.faults.dropped_line_frame,
                       "Drop a data line of this MD frame");
   command->add_option("--fault-stall", arguments->options.faults.stall_after_frames,

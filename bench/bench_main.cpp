@@ -2,6 +2,7 @@
 //   mlmap_bench [SCENE.json] [--quick]
 //   mlmap_bench icp SCENE_DIR [--runs N]   (pairwise ICP, see icp_pairs.cpp)
 //   mlmap_bench octree --poses POSES.txt SCAN...   (the OcTree layer alone, see octree_insert.cpp)
+//   mlmap_bench pacing [SCENE.json] [--seconds S] [--time-scale X]   (emulator_pacing.cpp)
 // Simulates the scene (default maps/lab.json), then times insertion into the block
 // layer alone and the OcTree alone on the same points, and reports map sizes at
 // several cell sizes.
@@ -19,6 +20,10 @@
 #include "mlmap/map/map.hpp"
 #include "mlmap/sim/scene.hpp"
 #include "mlmap/sim/simulator.hpp"
+
+namespace mlmap::bench {
+int runPacing(int argc, char** argv);
+}
 
 namespace {
 
@@ -41,6 +46,14 @@ double peakMemoryMb() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::strcmp(argv[1], "pacing") == 0) {
+    try {
+      return mlmap::bench::runPacing(argc - 1, argv + 1);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "mlmap_bench pacing: %s\n", error.what());
+      return 1;
+    }
+  }
   if (argc > 1 && std::strcmp(argv[1], "icp") == 0) {
     try {
       return mlmap::bench::runIcpPairs(argc - 1, argv + 1);

@@ -101,3 +101,47 @@ TEST_CASE("Driver under faults: every sweep completes or is refused cleanly, non
   CHECK(completed > 0);
   CHECK(refused > 0);
 }
+
+TEST_CASE("Driver under faults: each fault alone against a fresh emulator, and none unless asked") {
+  const auto scene = mlmap::sim::parseScene(kRoom, "fault_room.json");
+  struct Case {
+    const char* name;
+    EmulatorFaults faults;
+    bool completes;
+  };
+  const std::vector<Case> cases = {
+      {"none", {}, true},
+      {"bad checksum", {5, -1, -1, -1}, true},
+      {"dropped line", {-1, 5, -1, -1}, true},
+      {"stall", {-1, -1, 5, -1}, false},
+      {"disconnect", {-1, -1, -1, 5}, false},
+  };
+  for (const Case& fault : cases) {
+    CAPTURE(fault.name);
+    EmulatorOptions emulator_options;
+    emulator_options.time_scale = 4.0;
+    emulator_options.base_pose.translation() = Eigen::Vector3d(2.0, 2.0, 0.5);
+    emulator_options.faults = fault.faults;
+    SweepOptions options;
+    options.tilt_start_deg = -10.0;
+    options.tilt_end_deg = 10.0;
+    options.rho_deg = 2.0;
+    options.cluster = 8;
+    options.time_samples = 3;
+    options.timeout_ms = 250;
+    Emulator emulator(scene, emulator_options);
+    const auto laser_device = openDevice(emulator.laserPath());
+    const auto ptu_device = openDevice(emulator.ptuPath());
+    ScipClient laser(*laser_device, std::chrono::milliseconds(options.timeout_ms));
+    PtuClient ptu(*ptu_device, std::chrono::milliseconds(options.timeout_ms));
+    if (fault.completes) {
+      const SweepResult result = acquireScan(laser, ptu, options, mlmap::Pose::Identity());
+      CHECK(result.scan_lines >= 8);
+      // Exactly the spoiled frame is dropped; with no fault, none.
+      CHECK(result.dropped_frames == (fault.faults.bad_checksum_frame >= 0 || fault.faults.dropped_line_frame >= 0 ? 1u : 0u));
+    } else {
+      const std::string message = mlmap::test::errorOf([&] { acquireScan(laser, ptu, options, mlmap::Pose::Identity()); });
+      CHECK(mlmap::test::contains(message, emulator.laserPath()));
+    }
+  }
+}

@@ -38,36 +38,72 @@ int run(const std::string& arguments, const mlmap::test::TempDir& dir) {
   return WEXITSTATUS(std::system(command.c_str()));
 }
 
+// `mlmap emulate` in a child process, with the device names it prints.
+struct EmulateProcess {
+  pid_t child = 0;
+  std::string laser, ptu, output;
+  EmulateProcess(const mlmap::test::TempDir& dir, const std::string& arguments) {
+    output = (dir / "emulate.txt").string();
+    const std::string shell = std::string("exec ") + MLMAP_CLI_PATH + " emulate " + (dir / "box.json").string() +
+                              " " + arguments + " >" + output + " 2>&1";
+    const char* argv[] = {"/bin/sh", "-c", shell.c_str(), nullptr};
+    REQUIRE(posix_spawn(&child, "/bin/sh", nullptr, nullptr, const_cast<char* const*>(argv), environ) == 0);
+    for (int i = 0; i < 300 && ptu.empty(); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      std::istringstream lines(mlmap::test::readText(output));
+      std::string key, value;
+      while (lines >> key >> value) {
+        if (key == "laser:") laser = value;
+        if (key == "ptu:") ptu = value;
+      }
+    }
+  }
+  void stop() {
+    if (child <= 0) return;
+    ::kill(child, SIGINT);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    child = 0;
+  }
+  ~EmulateProcess() { stop(); }
+};
+
 }  // namespace
+
+TEST_CASE("CLI emulate --tcp: two scans in a row against one emulator") {
+  mlmap::test::TempDir dir;
+  mlmap::test::writeText(dir / "box.json", kBox);
+  EmulateProcess emulate(dir, "--tcp --time-scale 4 --duration 30");
+  REQUIRE_FALSE(emulate.ptu.empty());
+  REQUIRE(emulate.laser.rfind("tcp:127.0.0.1:", 0) == 0);
+  const std::string scans = (dir / "scans").string();
+  for (int scan = 0; scan < 2; ++scan) {
+    CAPTURE(scan);
+    const int scanned = run("scan -q --laser " + emulate.laser + " --ptu " + emulate.ptu + " -o " + scans +
+                                " --tilt-start -10 --tilt-end 10 --rho 2 --cluster 8 --pose 2 1.5 10",
+                            dir);
+    CHECK(scanned == 0);
+    CAPTURE(mlmap::test::readText(dir / "stderr.txt"));
+  }
+  emulate.stop();
+  CHECK(std::filesystem::exists(dir / "scans" / "scan_000.pcd"));
+  CHECK(std::filesystem::exists(dir / "scans" / "scan_001.pcd"));
+}
 
 TEST_CASE("CLI emulate + scan + replay: a scan, its log, the same scan again") {
   mlmap::test::TempDir dir;
   mlmap::test::writeText(dir / "box.json", kBox);
-  const std::string emulate_out = (dir / "emulate.txt").string();
-  const std::string shell = std::string("exec ") + MLMAP_CLI_PATH + " emulate " + (dir / "box.json").string() +
-                            " --time-scale 4 --duration 20 >" + emulate_out + " 2>&1";
-  const char* argv[] = {"/bin/sh", "-c", shell.c_str(), nullptr};
-  pid_t child = 0;
-  REQUIRE(posix_spawn(&child, "/bin/sh", nullptr, nullptr, const_cast<char* const*>(argv), environ) == 0);
-  std::string laser, ptu;
-  for (int i = 0; i < 200 && ptu.empty(); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    std::istringstream lines(mlmap::test::readText(emulate_out));
-    std::string key, value;
-    while (lines >> key >> value) {
-      if (key == "laser:") laser = value;
-      if (key == "ptu:") ptu = value;
-    }
-  }
+  EmulateProcess emulate(dir, "--time-scale 4 --duration 20");
+  const std::string& laser = emulate.laser;
+  const std::string& ptu = emulate.ptu;
+  const std::string emulate_out = emulate.output;
   REQUIRE_FALSE(ptu.empty());
   const std::string scans = (dir / "scans").string();
   const std::string log = (dir / "sweep.rawlog").string();
   const int scanned = run("scan -q --laser " + laser + " --ptu " + ptu + " -o " + scans + " --log " + log +
                               " --tilt-start -20 --tilt-end 20 --rho 2 --cluster 4 --pose 2 1.5 10",
                           dir);
-  ::kill(child, SIGINT);
-  int status = 0;
-  ::waitpid(child, &status, 0);
+  emulate.stop();
   REQUIRE(scanned == 0);
   CHECK(mlmap::test::contains(mlmap::test::readText(dir / "stdout.txt"), "scan_000.pcd"));
   CHECK(mlmap::test::contains(mlmap::test::readText(emulate_out), "laser scans sent"));

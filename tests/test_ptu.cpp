@@ -2,9 +2,12 @@
 #include <doctest/doctest.h>
 
 #include <chrono>
+#include <thread>
 
 #include "helpers.hpp"
+#include "mlmap/driver/emulator.hpp"
 #include "mlmap/driver/ptu.hpp"
+#include "mlmap/sim/scene.hpp"
 
 using namespace mlmap::driver;
 
@@ -83,4 +86,56 @@ TEST_CASE("PTU client: '!' replies, asynchronous limit errors, silence, await") 
   CHECK(ptu.awaitDone(std::chrono::milliseconds(200)));
   CHECK(ptu.awaitDone(std::chrono::milliseconds(0)));  // nothing pending
   CHECK(ptu.lastReplied() >= ptu.lastSent());
+}
+
+namespace {
+const char* const kEmptyRoom = R"({
+  "name": "ptu room",
+  "poses": [{"x": 0.0, "y": 0.0}],
+  "surfaces": [{"type": "box", "name": "room", "class": "wall", "min": [-3, -3, -1], "max": [3, 3, 2]}]
+})";
+}  // namespace
+
+TEST_CASE("PTU emulator, manual §4.2: lower-case commands as the ptu46 driver sends them") {
+  const auto scene = mlmap::sim::parseScene(kEmptyRoom, "room.json");
+  Emulator emulator(scene, EmulatorOptions{});
+  const auto device = openDevice(emulator.ptuPath(), 9600);
+  PtuClient ptu(*device, std::chrono::milliseconds(500));
+  // "Input characters may be in upper or lower case": ft ed ci tr, as ptu46 starts.
+  CHECK(ptu.exchange("ft", std::chrono::milliseconds(500)).empty());
+  CHECK(ptu.exchange("ed", std::chrono::milliseconds(500)).empty());
+  CHECK(ptu.exchange("ci", std::chrono::milliseconds(500)).empty());
+  CHECK(ptu.exchange("tr", std::chrono::milliseconds(500)) == "185.1428");
+  CHECK(ptu.exchange("Pn", std::chrono::milliseconds(500)) == "-3090");
+  ptu.initialise();  // the upper-case path still works after
+  CHECK(ptu.axis(PtuAxis::Tilt).max_position == Emulator::kTiltMax);
+}
+
+TEST_CASE("PTU emulator, manual §4.4.6-4.4.7: PL/TL speed bounds, C/CI/CV control modes") {
+  const auto scene = mlmap::sim::parseScene(kEmptyRoom, "room.json");
+  Emulator emulator(scene, EmulatorOptions{});
+  const auto device = openDevice(emulator.ptuPath(), 9600);
+  PtuClient ptu(*device, std::chrono::milliseconds(500));
+  ptu.initialise();
+  const auto timeout = std::chrono::milliseconds(500);
+  // §4.4.6's example: "PL * Minimum Pan speed is 31 positions/sec", then "PL40 *".
+  CHECK(ptu.exchange("PL", timeout) == "31");
+  CHECK(ptu.exchange("PL40", timeout).empty());
+  CHECK(ptu.exchange("PL", timeout) == "40");
+  CHECK(ptu.exchange("tl", timeout) == "31");
+  CHECK_THROWS_AS(ptu.exchange("TL-5", timeout), PtuError);
+  // §4.4.7: independent by default; in pure velocity mode a signed PS moves the axis.
+  CHECK(ptu.exchange("C", timeout) == "independent");
+  CHECK(ptu.exchange("CV", timeout).empty());
+  CHECK(ptu.exchange("c", timeout) == "pure velocity");
+  CHECK(ptu.exchange("PS-1000", timeout).empty());
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const int moved = ptu.position(PtuAxis::Pan);
+  CHECK(moved < -60);  // from 100 positions/s up at 2000/s²: 120 positions in 0.3 s
+  CHECK(ptu.exchange("PS0", timeout).empty());
+  const int stopped = ptu.position(PtuAxis::Pan);
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  CHECK(std::abs(ptu.position(PtuAxis::Pan) - stopped) <= 1);
+  CHECK(ptu.exchange("CI", timeout).empty());
+  CHECK_THROWS_AS(ptu.exchange("PS-1000", timeout), PtuError);  // independent: a magnitude
 }

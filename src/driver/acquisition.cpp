@@ -42,7 +42,7 @@ SweepResult runSweep(ScipClient& laser, PtuClient& ptu, const SweepOptions& opti
   SweepResult result;
 
   // Laser: stop whatever runs, read its parameters (never assumed), switch it on.
-  laser.stop();
+  laser.connect();  // SCIP 2.0 (a URG-04LX may start in SCIP 1.1), nothing running
   laser.versionInfo();
   result.laser = laser.parameters();
   laser.status();
@@ -96,7 +96,11 @@ SweepResult runSweep(ScipClient& laser, PtuClient& ptu, const SweepOptions& opti
   profile.acceleration_deg_s2 = acceleration * tilt_axis.degreesPerPosition();
   result.sweep_duration_s = profile.duration();
 
-  laser.startScans(parameters.first_step, parameters.last_step, options.cluster, true, 0);
+  if (options.intensity) {
+    laser.startIntensityScans(parameters.first_step, parameters.last_step, options.cluster, 0);
+  } else {
+    laser.startScans(parameters.first_step, parameters.last_step, options.cluster, true, 0);
+  }
   std::vector<ScipScan> lines;
   lines.push_back(laser.nextScan());  // the stream runs before the tilt starts
   ptu.setPosition(PtuAxis::Tilt, end_position);
@@ -156,6 +160,7 @@ SweepResult runSweep(ScipClient& laser, PtuClient& ptu, const SweepOptions& opti
       const double tilt = profile.angleAt(l) * kDegree;
       scan.points.push_back(beamPoint(options.mount, pan, tilt, parameters.stepAngle(step), range));  // eq. 4
       scan.variances.push_back(rangeVariance(range));
+      if (i < line.intensities.size()) result.intensities.push_back(line.intensities[i]);
     }
     if (used) ++result.scan_lines;
   }
@@ -212,6 +217,7 @@ std::string sweepToJson(const SweepOptions& options, const Pose& odometry_pose) 
   json["cluster"] = options.cluster;
   json["time_samples"] = options.time_samples;
   json["timeout_ms"] = options.timeout_ms;
+  json["intensity"] = options.intensity;
   json["mount"] = {{"tilt_axis_height", options.mount.tilt_axis_height},
                    {"laser_offset", {options.mount.laser_offset.x(), options.mount.laser_offset.y(),
                                      options.mount.laser_offset.z()}}};
@@ -259,6 +265,8 @@ void sweepFromJson(const std::string& json_text, const std::string& source_name,
     options.cluster = integerField<std::uint32_t>(json, "cluster", source_name);
     options.time_samples = integerField<int>(json, "time_samples", source_name);
     options.timeout_ms = integerField<int>(json, "timeout_ms", source_name);
+    // Logs from before ME was read have no "intensity": they streamed MD.
+    options.intensity = json.contains("intensity") && json.at("intensity").get<bool>();
     options.mount = parseMountConfig(json.at("mount").dump(), source_name + ": mount");
     const auto matrix = json.at("odometry_pose").get<std::vector<double>>();
     if (matrix.size() != 16) throw Error(source_name + ": odometry_pose: expected 16 numbers");

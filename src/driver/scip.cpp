@@ -1,5 +1,6 @@
 #include "mlmap/driver/scip.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -36,19 +37,57 @@ std::string decimal(std::uint32_t value, int width) {
   return std::string(static_cast<std::size_t>(width) - text.size(), '0') + text;
 }
 
-std::string statusMeaning(std::string_view status) {
-  if (status == "01" || status == "02" || status == "03" || status == "04" || status == "05" ||
-      status == "06" || status == "07" || status == "08" || status == "09" || status == "0A" ||
-      status == "0B" || status == "0C") {
-    return " (parameter error)";
+}  // namespace
+
+std::string scipStatusMeaning(std::string_view command, std::string_view status) {
+  const std::string_view symbol = command.substr(0, 2);
+  const bool scan = symbol == "MD" || symbol == "MS" || symbol == "ME" || symbol == "GD" || symbol == "GS";
+  if (scan) {  // §8.1, §8.2
+    if (status == "01") return "starting step has a non-numeric value";
+    if (status == "02") return "end step has a non-numeric value";
+    if (status == "03") return "cluster count has a non-numeric value";
+    if (status == "04") return "end step is out of range";
+    if (status == "05") return "end step is smaller than the starting step";
+    if (status == "06") return "scan interval has a non-numeric value";
+    if (status == "07") return "number of scans has a non-numeric value";
+    if (status == "10") return "laser is off";
+    if (status == "98") return "resumption after confirming normal laser operation";
+    if (status.size() == 2 && status[0] >= '2' && status[0] <= '4' && status[1] >= '0' && status[1] <= '9') {
+      return "processing stopped to verify an error";
+    }
   }
-  if (status == "0E") return " (command not supported)";
-  if (status == "0F") return " (unknown command)";
-  if (status == "10") return " (busy / laser off)";
-  if (status == "50" || status == "60" || status == "70") return " (hardware malfunction)";
+  if (symbol == "BM") {  // §8.3
+    if (status == "01") return "unable to control the laser (malfunction)";
+    if (status == "02") return "laser is already on";
+  }
+  if (symbol == "TM") {  // §8.6
+    if (status == "01") return "invalid control code";
+    if (status == "02") return "adjust mode is already on";
+    if (status == "03") return "adjust mode is already off";
+    if (status == "04") return "adjust mode is off when the time was requested";
+  }
+  // §9, any command
+  if (status == "0A") return "unable to create transmission data or reply";
+  if (status == "0B") return "buffer shortage, or a command repeated that is already being processed";
+  if (status == "0C") return "command with insufficient parameters (1)";
+  if (status == "0D") return "undefined command (1)";
+  if (status == "0E") return "undefined command (2)";
+  if (status == "0F") return "command with insufficient parameters (2)";
+  if (status == "0G") return "string characters exceed 16 letters";
+  if (status == "0H") return "string characters have invalid letters";
+  if (status == "0I") return "sensor is in firmware update mode";
+  if (status.size() == 2 && status[0] >= '5' && status[0] <= '9' && status != "99") {
+    return "hardware trouble (laser, motor)";
+  }
+  if (status.size() == 1) return "a SCIP 1.1 status: the sensor is not in SCIP 2.0";
   return "";
 }
 
+namespace {
+std::string statusMeaning(std::string_view command, std::string_view status) {
+  const std::string meaning = scipStatusMeaning(command, status);
+  return meaning.empty() ? "" : " (" + meaning + ")";
+}
 }  // namespace
 
 char scipChecksum(std::string_view text) {
@@ -184,7 +223,8 @@ ScipFrame ScipClient::readFrame(std::string_view expected_echo_prefix) {
       throw ScipError(ScipError::Kind::Checksum,
                       device + ": " + echo + ": bad checksum on status " + quoted(status_line));
     }
-    if (status_line.size() != 3 && status_line.size() != 2) {
+    // One character without a sum: a SCIP 1.1 reply (spec §2), reported as such.
+    if (status_line.size() != 3 && status_line.size() != 2 && status_line.size() != 1) {
       throw ScipError(ScipError::Kind::Malformed,
                       device + ": " + echo + ": bad status line " + quoted(status_line));
     }
@@ -200,7 +240,7 @@ ScipFrame ScipClient::command(const std::string& text, std::initializer_list<std
     if (frame.status == status) return frame;
   }
   throw ScipError(ScipError::Kind::Status, reader_.transport().name() + ": " + text + ": status " +
-                                               quoted(frame.status) + statusMeaning(frame.status));
+                                               quoted(frame.status) + statusMeaning(text, frame.status));
 }
 
 std::map<std::string, std::string> ScipClient::keyValues(const ScipFrame& frame,
@@ -228,6 +268,33 @@ std::map<std::string, std::string> ScipClient::keyValues(const ScipFrame& frame,
         std::string(payload.substr(colon + 1, payload.size() - colon - 2));
   }
   return values;
+}
+
+bool ScipClient::connect() {
+  Transport& transport = reader_.transport();
+  stream_echo_.clear();
+  transport.write("QT\n");
+  const ScipFrame first = readFrame("QT");
+  if (first.status == "00") return false;
+  bool switched = false;
+  if (first.status.size() == 1) {  // SCIP 1.1 answered
+    transport.write("SCIP2.0\n");
+    const ScipFrame reply = readFrame("SCIP2.0");
+    if (reply.status != "0" && reply.status != "00") {
+      throw ScipError(ScipError::Kind::Status,
+                      transport.name() + ": SCIP2.0: status " + quoted(reply.status) +
+                          ": the sensor would not switch to SCIP 2.0");
+    }
+    switched = true;
+  } else if (first.status == "0E") {  // in time adjust mode (§8.6), which takes no QT
+    transport.write("TM2\n");
+    readFrame("TM2");
+  } else {
+    throw ScipError(ScipError::Kind::Status, transport.name() + ": QT: status " + quoted(first.status) +
+                                                 statusMeaning("QT", first.status));
+  }
+  command("QT", {"00"});
+  return switched;
 }
 
 std::map<std::string, std::string> ScipClient::versionInfo() {
@@ -339,18 +406,30 @@ ClockModel fitClock(const std::vector<ScipClient::TimeSample>& samples) {
 }
 
 void ScipClient::startScans(std::uint32_t start_step, std::uint32_t end_step, std::uint32_t cluster,
-                            bool three_characters, std::uint32_t count) {
-  if (start_step > end_step || cluster == 0 || cluster > 99 || count > 99) {
-    throw Error(reader_.transport().name() + ": MD: bad step range or cluster");
+                            bool three_characters, std::uint32_t count, std::uint32_t interval) {
+  startStream(three_characters ? "MD" : "MS", start_step, end_step, cluster, count, interval);
+}
+
+void ScipClient::startIntensityScans(std::uint32_t start_step, std::uint32_t end_step, std::uint32_t cluster,
+                                     std::uint32_t count, std::uint32_t interval) {
+  startStream("ME", start_step, end_step, cluster, count, interval);
+}
+
+void ScipClient::startStream(const std::string& symbol, std::uint32_t start_step, std::uint32_t end_step,
+                             std::uint32_t cluster, std::uint32_t count, std::uint32_t interval) {
+  if (start_step > end_step || cluster > 99 || count > 99 || interval > 9) {
+    throw Error(reader_.transport().name() + ": " + symbol +
+                ": bad step range, cluster (1-99), count (0-99) or interval (0-9)");
   }
-  const std::string text = std::string(three_characters ? "MD" : "MS") + decimal(start_step, 4) +
-                           decimal(end_step, 4) + decimal(cluster, 2) + "0" + decimal(count, 2);
+  const std::string text = symbol + decimal(start_step, 4) + decimal(end_step, 4) + decimal(cluster, 2) +
+                           decimal(interval, 1) + decimal(count, 2);
   command(text, {"00"});
   stream_echo_ = text.substr(0, 13);  // the remaining-scan count changes from frame to frame
-  stream_width_ = three_characters ? 3 : 2;
+  stream_width_ = symbol == "MS" ? 2 : 3;
+  stream_intensities_ = symbol == "ME";
   stream_start_ = start_step;
   stream_end_ = end_step;
-  stream_cluster_ = cluster;
+  stream_cluster_ = std::max<std::uint32_t>(cluster, 1);  // §8.1: 00 and 01 alike
 }
 
 ScipScan ScipClient::nextScan(int max_drops) {
@@ -363,9 +442,9 @@ ScipScan ScipClient::nextScan(int max_drops) {
       if (frame.status != "99") {
         throw ScipError(ScipError::Kind::Status, reader_.transport().name() + ": " + frame.echo +
                                                      ": status " + quoted(frame.status) +
-                                                     statusMeaning(frame.status));
+                                                     statusMeaning(frame.echo, frame.status));
       }
-      ScipScan scan = decodeScan(frame, stream_width_, true);
+      ScipScan scan = decodeScan(frame, stream_width_, true, stream_intensities_);
       ++counters_.frames;
       return scan;
     } catch (const ScipError& error) {
@@ -384,21 +463,21 @@ ScipScan ScipClient::nextScan(int max_drops) {
 
 ScipScan ScipClient::singleScan(std::uint32_t start_step, std::uint32_t end_step,
                                 std::uint32_t cluster, bool three_characters) {
-  if (start_step > end_step || cluster == 0 || cluster > 99) {
+  if (start_step > end_step || cluster > 99) {
     throw Error(reader_.transport().name() + ": GD: bad step range or cluster");
   }
   const std::string text = std::string(three_characters ? "GD" : "GS") + decimal(start_step, 4) +
                            decimal(end_step, 4) + decimal(cluster, 2);
   stream_start_ = start_step;
   stream_end_ = end_step;
-  stream_cluster_ = cluster;
+  stream_cluster_ = std::max<std::uint32_t>(cluster, 1);
   const ScipFrame frame = command(text, {"00"});
   ScipScan scan = decodeScan(frame, three_characters ? 3 : 2, true);
   ++counters_.frames;
   return scan;
 }
 
-ScipScan ScipClient::decodeScan(const ScipFrame& frame, int width, bool has_timestamp) {
+ScipScan ScipClient::decodeScan(const ScipFrame& frame, int width, bool has_timestamp, bool intensities) {
   const std::string& device = reader_.transport().name();
   const std::string where = device + ": " + frame.echo;
   std::size_t first_data = 0;
@@ -426,15 +505,24 @@ ScipScan ScipClient::decodeScan(const ScipFrame& frame, int width, bool has_time
     }
     data.append(line, 0, line.size() - 1);
   }
+  // One value per cluster (the last one may hold fewer steps); ME: a range and an intensity each.
   const std::size_t expected = (stream_end_ - stream_start_) / stream_cluster_ + 1;
-  if (data.size() != expected * static_cast<std::size_t>(width)) {
+  const std::size_t per_value = static_cast<std::size_t>(width) * (intensities ? 2 : 1);
+  if (data.size() != expected * per_value) {
     throw ScipError(ScipError::Kind::Truncated,
                     where + ": " + std::to_string(data.size()) + " data characters, expected " +
-                        std::to_string(expected * static_cast<std::size_t>(width)));
+                        std::to_string(expected * per_value));
   }
   auto values = scipDecodeValues(data, width);
   if (!values) throw ScipError(ScipError::Kind::Malformed, where + ": character outside the SCIP range");
-  scan.ranges_mm = std::move(*values);
+  if (intensities) {
+    for (std::size_t i = 0; i < values->size(); i += 2) {
+      scan.ranges_mm.push_back((*values)[i]);
+      scan.intensities.push_back((*values)[i + 1]);
+    }
+  } else {
+    scan.ranges_mm = std::move(*values);
+  }
   scan.start_step = stream_start_;
   scan.end_step = stream_end_;
   scan.cluster = stream_cluster_;

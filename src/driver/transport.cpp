@@ -8,6 +8,7 @@
 #include <poll.h>
 #include <sys/socket.h>
 #include <termios.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -56,7 +57,10 @@ double hostSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-FdTransport::FdTransport(int fd, std::string name) : fd_(fd), name_(std::move(name)) {}
+FdTransport::FdTransport(int fd, std::string name) : fd_(fd), name_(std::move(name)) {
+  struct stat status {};
+  socket_ = ::fstat(fd_, &status) == 0 && S_ISSOCK(status.st_mode);
+}
 
 FdTransport::~FdTransport() {
   if (fd_ >= 0) ::close(fd_);
@@ -65,7 +69,10 @@ FdTransport::~FdTransport() {
 void FdTransport::write(std::string_view bytes) {
   std::size_t done = 0;
   while (done < bytes.size()) {
-    const ssize_t written = ::write(fd_, bytes.data() + done, bytes.size() - done);
+    // A socket whose peer has gone must fail with EPIPE, not raise SIGPIPE and end the
+    // process (an emulator whose client hung up serves the next one).
+    const ssize_t written = socket_ ? ::send(fd_, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL)
+                                    : ::write(fd_, bytes.data() + done, bytes.size() - done);
     if (written < 0) {
       if (errno == EINTR) continue;
       if (errno == EAGAIN) {

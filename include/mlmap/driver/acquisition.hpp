@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "mlmap/driver/kinematics.hpp"
 #include "mlmap/driver/ptu.hpp"
@@ -28,11 +29,13 @@ struct SweepOptions {
   std::uint32_t cluster = 1;        // laser steps merged into one measurement (1–99)
   int time_samples = 6;             // TM round trips before and after the sweep
   int timeout_ms = 1000;            // ms, longest silence accepted from either device
+  bool intensity = false;           // stream ME (ranges + intensities) instead of MD
   MountConfig mount;
 };
 
 struct SweepResult {
   Scan scan;                     // base-frame points, variance from range, pose = odometry
+  std::vector<std::uint32_t> intensities;  // per point of `scan` with SweepOptions::intensity
   std::size_t scan_lines = 0;    // laser scans inside the sweep
   std::size_t dropped_frames = 0;      // frames that failed their checks
   std::size_t missed_revolutions = 0;  // gaps in the laser's timestamps (frames never sent)

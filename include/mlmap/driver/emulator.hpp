@@ -24,9 +24,11 @@
 
 namespace mlmap::driver {
 
+// Injected faults. Each is off unless set to 0 or more, and counts only MD/MS/ME data
+// frames (0-based, over the emulator's life), never GD/GS replies or acknowledgements.
 struct EmulatorFaults {
-  int bad_checksum_frame = -1;  // MD/MS data frame (0-based) whose data line gets a wrong sum
-  int dropped_line_frame = -1;  // data frame that loses one data line
+  int bad_checksum_frame = -1;  // data frame whose second data line gets a wrong sum
+  int dropped_line_frame = -1;  // data frame that loses its third data line
   int stall_after_frames = -1;  // laser goes silent after this many data frames
   int disconnect_after_frames = -1;  // laser hangs up after this many data frames
 };
@@ -40,6 +42,9 @@ struct EmulatorOptions {
   Pose base_pose = Pose::Identity();  // pan-tilt base frame -> scene (world) frame
   bool laser_over_tcp = false;       // laser on a loopback TCP port instead of a pty
   int tcp_port = 0;                  // 0: any free port
+  // Start in SCIP 1.1 like a URG-04LX fresh from the factory: every command but "SCIP2.0"
+  // is answered with SCIP 1.1's one-character status "E" until the host switches (spec §2).
+  bool start_in_scip11 = false;
   EmulatorFaults faults;
 };
 
@@ -72,25 +77,38 @@ class Emulator {
   };
   struct Axis {
     std::vector<Move> history;
-    int speed = 1000, base = 100, accel = 2000, upper = 2900;  // positions/s, /s²
+    // positions/s, /s²; upper and lower bounds as the manual's §4.4.6 example reports them
+    int speed = 1000, base = 100, accel = 2000, upper = 2900, lower = 31;
     int min = 0, max = 0;
     int target = 0;
   };
 
   double emulatedSeconds() const;
   double axisDeg(const Axis& axis, double t) const;
+  // An MD/MS/ME stream or a GD/GS single scan, as requested (emulator_laser.cpp).
+  struct ScanRequest {
+    bool active = false;
+    std::string echo;  // MD/MS/ME: up to the scan interval; GD/GS: the whole command
+    std::string tag;   // string characters with their ';' (spec §7), echoed back
+    char encoding = 'D';  // 'D' 3-character, 'S' 2-character, 'E' ranges + intensities
+    std::uint32_t start = 0, end = 0, cluster = 1, skip = 0, remaining = 0;
+    bool endless = true;
+    std::uint64_t next_revolution = 0;
+  };
   void laserLoop();
+  bool serveLaserClient();  // false once the emulator stops or the laser is gone for good
   void ptuLoop();
-  std::string handleScip(const std::string& command);
+  void resetLaserState();
+  std::string handleScip(const std::string& line);
+  std::string scanRequest(const std::string& echo, const std::string& body, const std::string& tag);
   std::string scanFrame(const std::string& echo, const std::string& status, std::uint64_t revolution,
-                        std::uint32_t start, std::uint32_t end, std::uint32_t cluster, int width,
-                        int frame_index);
-  std::string handlePtu(const std::string& command, bool& deferred_await);
+                        const ScanRequest& request, int frame_index);
+  std::uint32_t deviceMs(double emulated_s) const;
+  std::string handlePtu(const std::string& raw_command, bool& deferred_await);
   bool ptuIdle(double t) const;
 
   sim::Scene scene_;
   EmulatorOptions options_;
-  std::unique_ptr<sim::RayCaster> caster_;
   std::unique_ptr<FdTransport> laser_, ptu_;
   std::unique_ptr<TcpListener> listener_;
   int laser_slave_hold_ = -1, ptu_slave_hold_ = -1;
@@ -103,7 +121,13 @@ class Emulator {
   std::atomic<std::size_t> frames_sent_{0};
   std::atomic<std::size_t> skipped_revolutions_{0};
   // laser state (laser thread only)
-  bool laser_on_ = false, time_adjust_ = false, echo_ptu_ = true, terse_ = false, slaved_ = false;
+  bool laser_on_ = false, time_adjust_ = false, scip2_ = true;
+  ScanRequest stream_, single_;
+  int data_frames_ = 0;  // MD/MS/ME data frames sent (the faults count these)
+  bool stalled_ = false, gone_ = false;
+  // pan-tilt state (PTU thread only)
+  bool echo_ptu_ = true, terse_ = false, slaved_ = false;
+  char control_mode_ = 'I';  // CI independent (position control) or CV pure velocity
   std::thread laser_thread_, ptu_thread_;
 };
 

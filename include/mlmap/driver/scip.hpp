@@ -33,6 +33,10 @@ std::optional<std::vector<std::uint32_t>> scipDecodeValues(std::string_view char
 // A line with its sum character appended, then '\n' (what a device sends).
 std::string scipLine(std::string_view payload);
 
+// What a status means for `command` (its two-letter symbol is enough), from the tables of
+// C-42-03320B: §8.1-8.6 per command, §9 for invalid commands; "" when unknown.
+std::string scipStatusMeaning(std::string_view command, std::string_view status);
+
 class ScipError : public Error {
  public:
   enum class Kind { Checksum, Status, Truncated, Timeout, Malformed };
@@ -72,6 +76,7 @@ struct ScipScan {
   std::uint32_t end_step = 0;
   std::uint32_t cluster = 1;
   std::vector<std::uint32_t> ranges_mm;  // one per cluster; below DMIN = error code
+  std::vector<std::uint32_t> intensities;  // ME: one per cluster; empty for MD/MS/GD/GS
 };
 
 // Device clock vs host clock, fitted on TM round trips: device_s = offset + rate·host_s.
@@ -102,6 +107,10 @@ class ScipClient {
   explicit ScipClient(Transport& transport,
                       std::chrono::milliseconds timeout = std::chrono::milliseconds(1000));
 
+  // Makes sure the sensor speaks SCIP 2.0 and is idle (spec §2, as urg_library does it):
+  // QT; a one-character status ("E", SCIP 1.1) is answered with "SCIP2.0", a 0E (time
+  // adjust mode) with TM2, and QT is sent again. Returns true when it switched to SCIP 2.0.
+  bool connect();
   std::map<std::string, std::string> versionInfo();  // VV
   ScipParameters parameters();                         // PP (also kept for decoding)
   std::map<std::string, std::string> status();         // II
@@ -116,9 +125,13 @@ class ScipClient {
   };
   std::vector<TimeSample> timeSamples(int samples);
 
-  // MD (3-character) or MS (2-character): `count` scans, 0 = until QT.
+  // MD (3-character) or MS (2-character): `count` scans, 0 = until QT; `interval`
+  // revolutions skipped after each scan sent (0-9, spec §8.1).
   void startScans(std::uint32_t start_step, std::uint32_t end_step, std::uint32_t cluster,
-                  bool three_characters = true, std::uint32_t count = 0);
+                  bool three_characters = true, std::uint32_t count = 0, std::uint32_t interval = 0);
+  // ME: ranges and intensities (3 characters each), otherwise as MD.
+  void startIntensityScans(std::uint32_t start_step, std::uint32_t end_step, std::uint32_t cluster,
+                           std::uint32_t count = 0, std::uint32_t interval = 0);
   // The next good scan of the stream; frames that fail their checks are dropped and
   // counted (resynchronising on the next frame) — at most `max_drops` in a row before
   // the last error is rethrown. Throws ScipError(Timeout) when nothing comes in time.
@@ -135,7 +148,9 @@ class ScipClient {
   ScipFrame command(const std::string& text, std::initializer_list<std::string_view> ok);
   ScipFrame readFrame(std::string_view expected_echo_prefix);
   std::map<std::string, std::string> keyValues(const ScipFrame& frame, const std::string& command);
-  ScipScan decodeScan(const ScipFrame& frame, int width, bool has_timestamp);
+  ScipScan decodeScan(const ScipFrame& frame, int width, bool has_timestamp, bool intensities = false);
+  void startStream(const std::string& symbol, std::uint32_t start_step, std::uint32_t end_step,
+                   std::uint32_t cluster, std::uint32_t count, std::uint32_t interval);
 
   LineReader reader_;
   std::chrono::milliseconds timeout_;
@@ -144,6 +159,7 @@ class ScipClient {
   ScipCounters counters_;
   std::string stream_echo_;  // MD/MS echo prefix while streaming
   int stream_width_ = 3;
+  bool stream_intensities_ = false;
   std::uint32_t stream_start_ = 0, stream_end_ = 0, stream_cluster_ = 1;
 };
 

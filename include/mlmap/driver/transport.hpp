@@ -47,6 +47,7 @@ class FdTransport : public Transport {
  private:
   int fd_;
   std::string name_;
+  bool socket_ = false;
 };
 
 // Opens a serial device in raw mode (8N1, no flow control, no echo) at `baud`
