@@ -10,6 +10,8 @@
 #include "mlmap/error.hpp"
 #include "mlmap/io/block_ply.hpp"
 #include "mlmap/io/dashboard.hpp"
+#include "mlmap/io/dashboard_blocks.hpp"
+#include "mlmap/io/dashboard_voxels.hpp"
 #include "mlmap/io/map_file.hpp"
 #include "mlmap/io/octree_export.hpp"
 #include "mlmap/io/planes_json.hpp"
@@ -25,6 +27,7 @@ struct ExportArguments {
   std::string json;
   std::string dashboard;
   std::string dashboard_page;
+  bool dashboard_voxels = false;
 };
 
 // The built dashboard: $MLMAP_DASHBOARD_PAGE, else beside the executable as in a
@@ -49,6 +52,7 @@ int runExport(const ExportArguments& arguments, bool quiet) {
       arguments.json.empty() && arguments.dashboard.empty()) {
     throw Error("nothing to export: give at least one of --octovis, --bt, --ply, --json, --dashboard");
   }
+  if (arguments.dashboard_voxels && arguments.dashboard.empty()) throw Error("--dashboard-voxels needs --dashboard DIR");
   // Find the page before any work, so a missing build fails at once.
   std::optional<std::filesystem::path> page;
   if (!arguments.dashboard.empty()) page = findDashboardPage(arguments.dashboard_page);
@@ -86,7 +90,9 @@ int runExport(const ExportArguments& arguments, bool quiet) {
     done("planes JSON", arguments.json);
   }
   if (page) {
-    io::writeDashboard(arguments.dashboard, *page, io::planesJson(map, *map.planes(), source));
+    io::writeDashboard(arguments.dashboard, *page, io::planesJson(map, *map.planes(), source),
+                       io::dashboardBlocks(map.blocks()),
+                       arguments.dashboard_voxels ? io::dashboardVoxels(map) : std::string());
     done("dashboard", (std::filesystem::path(arguments.dashboard) / "index.html").string());
   }
   return 0;
@@ -105,7 +111,9 @@ void addExportCommand(CLI::App& app, Context& context) {
   command->add_option("--ply", arguments->ply, "Block centres with normal, label and colour (binary PLY)");
   command->add_option("--json", arguments->json, "Planes JSON (schema mlmap.planes/1)");
   command->add_option("--dashboard", arguments->dashboard,
-                      "Directory for the web dashboard with the planes (open DIR/index.html)");
+                      "Directory for the web dashboard with the planes and blocks (open DIR/index.html)");
+  command->add_flag("--dashboard-voxels", arguments->dashboard_voxels,
+                    "Add the occupied voxels to the dashboard (those of --octovis; 16 bytes a voxel)");
   command->add_option("--dashboard-page", arguments->dashboard_page,
                       "The built dashboard page (default: web/dist/index.html beside the build)");
   command->callback([arguments, &context] {

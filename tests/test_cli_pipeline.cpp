@@ -3,11 +3,14 @@
 #include <doctest/doctest.h>
 
 #include <fstream>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
 #include "helpers.hpp"
 #include "json_schema.hpp"
+#include "mlmap/io/dashboard.hpp"
+#include "mlmap/io/dashboard_blocks.hpp"
 #include "mlmap/io/map_file.hpp"
 #include "mlmap/io/tum_poses.hpp"
 #include "mlmap/io/xyz.hpp"
@@ -83,7 +86,8 @@ TEST_CASE("CLI: planes -o keeps the planes in the map, and export writes every f
                   (out / "m.json").string() + " --dashboard " + (out / "web").string() + " --dashboard-page " +
                   (rooms.dir / "page.html").string());
   REQUIRE_MESSAGE(result.exit_code == 0, result.output);
-  for (const char* name : {"m.ot", "m.bt", "m.ply", "m.json", "web/index.html", "web/planes.json", "web/planes.js"}) {
+  for (const char* name : {"m.ot", "m.bt", "m.ply", "m.json", "web/index.html", "web/planes.json", "web/planes.js",
+                           "web/blocks.bin", "web/blocks.js"}) {
     CHECK_MESSAGE(fs::file_size(out / name) > 0, name);
   }
   std::ifstream schema_file(mlmap::test::sourceDir() / "web" / "planes.schema.json");
@@ -94,6 +98,21 @@ TEST_CASE("CLI: planes -o keeps the planes in the map, and export writes every f
   CHECK(exported["planes"].size() == mlmap::io::readMap(labelled).planes()->planes.size());
   CHECK(mlmap::test::readText(out / "web" / "planes.json") == mlmap::test::readText(out / "m.json"));
   CHECK(mlmap::test::readText(out / "web" / "planes.js").rfind("window.MLMAP_PLANES = {", 0) == 0);
+  // The blocks layer: every block of the map, labelled with the ids of the JSON's planes.
+  const std::string blocks_bytes = mlmap::test::readText(out / "web" / "blocks.bin");
+  const mlmap::io::DashboardBlocks blocks = mlmap::io::parseDashboardBlocks(blocks_bytes, "blocks.bin");
+  CHECK(blocks.blocks.size() == mlmap::io::readMap(labelled).blocks().blockCount());
+  std::set<std::int64_t> plane_ids;
+  for (const auto& plane : exported["planes"]) plane_ids.insert(plane["id"].get<std::int64_t>());
+  std::size_t labelled_blocks = 0;
+  for (const auto& block : blocks.blocks) {
+    if (block.plane == 0) continue;
+    ++labelled_blocks;
+    CHECK_MESSAGE(plane_ids.count(block.plane) == 1, block.plane);
+  }
+  CHECK(labelled_blocks > blocks.blocks.size() / 2);
+  CHECK(mlmap::test::readText(out / "web" / "blocks.js") ==
+        "window.MLMAP_BLOCKS = \"" + mlmap::io::base64(blocks_bytes) + "\";\n");
 
   // Without a page, --dashboard fails at once and writes nothing.
   result = runCli("--quiet export " + labelled.string() + " --dashboard " + (out / "web2").string() +

@@ -11,6 +11,7 @@
 #include "helpers.hpp"
 #include "mlmap/error.hpp"
 #include "mlmap/io/block_ply.hpp"
+#include "mlmap/io/dashboard_voxels.hpp"
 #include "mlmap/io/octree_export.hpp"
 #include "mlmap/io/palette.hpp"
 #include "mlmap/io/ply.hpp"
@@ -110,6 +111,40 @@ TEST_CASE("Export: the ColorOcTree reads back through AbstractOcTree::read with 
     ++exported;
   }
   CHECK(exported == occupied);
+}
+
+TEST_CASE("Export: the dashboard's voxels are the ColorOcTree's, each with the plane of its colour") {
+  const Map map = labelledRooms(true);
+  const std::unique_ptr<octomap::ColorOcTree> coloured = io::colouredOctree(map);
+  const std::string bytes = io::dashboardVoxels(map);
+  const io::DashboardVoxels read = io::parseDashboardVoxels(bytes, "voxels.bin");
+  CHECK(read.voxel_size == doctest::Approx(coloured->getResolution()));
+  CHECK(bytes.size() == 24 + 16 * read.voxels.size());
+  CHECK(read.voxels.size() == coloured->getNumLeafNodes());
+  std::set<std::tuple<int, int, int>> seen;
+  std::size_t labelled = 0;
+  for (const io::DashboardVoxel& voxel : read.voxels) {
+    const Eigen::Vector3d centre =
+        (Eigen::Vector3d(voxel.index[0], voxel.index[1], voxel.index[2]) + Eigen::Vector3d::Constant(0.5)) * read.voxel_size;
+    const octomap::ColorOcTreeNode* node = coloured->search(centre.x(), centre.y(), centre.z());
+    REQUIRE(node != nullptr);
+    CHECK(coloured->isNodeOccupied(node));
+    const auto colour = node->getColor();
+    CHECK(io::Rgb{colour.r, colour.g, colour.b} == io::planeColour(voxel.plane));
+    CHECK(seen.emplace(voxel.index[0], voxel.index[1], voxel.index[2]).second);
+    labelled += voxel.plane != 0 ? 1 : 0;
+  }
+  CHECK(labelled > read.voxels.size() / 2);
+  // Damaged files are refused, naming the file.
+  CHECK_THROWS_WITH(io::parseDashboardVoxels(bytes.substr(0, bytes.size() - 2), "v.bin"),
+                    doctest::Contains("v.bin: the header says"));
+  CHECK_THROWS_WITH(io::parseDashboardVoxels("MLBLOCKS", "v.bin"), "v.bin: not an mlmap voxels file (no \"MLVOXELS\" header)");
+  std::string version_two = bytes;
+  version_two[8] = 2;
+  CHECK_THROWS_WITH(io::parseDashboardVoxels(version_two, "v.bin"), "v.bin: voxels file version 2, this reader knows version 1");
+  std::string no_size = bytes;
+  std::fill(no_size.begin() + 16, no_size.begin() + 24, '\0');
+  CHECK_THROWS_WITH(io::parseDashboardVoxels(no_size, "v.bin"), "v.bin: the voxel size is not a positive number");
 }
 
 TEST_CASE("Export: the palette is stable, grey for no plane, and neighbouring ids differ") {

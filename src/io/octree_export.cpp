@@ -10,6 +10,7 @@
 #include "mlmap/io/palette.hpp"
 #include "mlmap/map/surface_points.hpp"
 #include "../map/leaf_voxels.hpp"
+#include "occupied_voxels.hpp"
 
 namespace mlmap::io {
 namespace {
@@ -49,44 +50,51 @@ octomap::point3d toPoint3d(const Eigen::Vector3d& point) {
   return {static_cast<float>(point.x()), static_cast<float>(point.y()), static_cast<float>(point.z())};
 }
 
-void addVoxel(octomap::ColorOcTree& tree, const MLMap& blocks, const octomap::point3d& centre, float log_odds) {
+// The centre as OctoMap holds it (single precision), so the plane is looked up where the
+// ColorOcTree puts the voxel, exactly as before this was shared with the dashboard.
+Eigen::Vector3d toPoint3dPrecision(const Eigen::Vector3d& point) { return point.cast<float>().cast<double>(); }
+
+void addVoxel(octomap::ColorOcTree& tree, const octomap::point3d& centre, float log_odds, std::int32_t plane) {
   octomap::OcTreeKey key;
   if (!tree.coordToKeyChecked(centre, key)) return;
   tree.setNodeValue(key, log_odds, true);
-  const Rgb colour = planeColour(planeAt(blocks, Eigen::Vector3d(centre.x(), centre.y(), centre.z()),
-                                         tree.getResolution()));
+  const Rgb colour = planeColour(plane);
   tree.setNodeColor(key, colour.red, colour.green, colour.blue);
-}
-
-void voxelsFromOctree(octomap::ColorOcTree& tree, const Map& map) {
-  const octomap::OcTree& source = map.octree();
-  const double resolution = source.getResolution();
-  for (auto leaf = source.begin_leafs(), end = source.end_leafs(); leaf != end; ++leaf) {
-    if (!source.isNodeOccupied(*leaf)) continue;
-    const float log_odds = leaf->getLogOdds();
-    forEachVoxelOfLeaf(leaf, resolution, [&](const Eigen::Vector3d& corner) {
-      addVoxel(tree, map.blocks(), toPoint3d(corner + Eigen::Vector3d::Constant(resolution / 2.0)), log_odds);
-    });
-  }
-}
-
-void voxelsFromBlocks(octomap::ColorOcTree& tree, const MLMap& blocks) {
-  const float occupied = tree.getClampingThresMaxLog();
-  for (const Point& point : blockSurfacePoints(blocks, tree.getResolution())) {
-    addVoxel(tree, blocks, toPoint3d(point), occupied);
-  }
 }
 
 }  // namespace
 
-std::unique_ptr<octomap::ColorOcTree> colouredOctree(const Map& map) {
-  const double resolution = map.hasOctree() ? map.octree().getResolution() : map.config().cell_size;
-  auto tree = std::make_unique<octomap::ColorOcTree>(resolution);
+double occupiedVoxelSize(const Map& map) {
+  return map.hasOctree() ? map.octree().getResolution() : map.config().cell_size;
+}
+
+void forEachOccupiedVoxel(const Map& map, const std::function<void(const Eigen::Vector3d&, float, std::int32_t)>& visit) {
+  const double resolution = occupiedVoxelSize(map);
   if (map.hasOctree()) {
-    voxelsFromOctree(*tree, map);
+    const octomap::OcTree& source = map.octree();
+    for (auto leaf = source.begin_leafs(), end = source.end_leafs(); leaf != end; ++leaf) {
+      if (!source.isNodeOccupied(*leaf)) continue;
+      const float log_odds = leaf->getLogOdds();
+      forEachVoxelOfLeaf(leaf, resolution, [&](const Eigen::Vector3d& corner) {
+        const Eigen::Vector3d centre = toPoint3dPrecision(corner + Eigen::Vector3d::Constant(resolution / 2.0));
+        visit(centre, log_odds, planeAt(map.blocks(), centre, resolution));
+      });
+    }
   } else {
-    voxelsFromBlocks(*tree, map.blocks());
+    // A map without an OcTree: voxels from its blocks at the cell size.
+    const float occupied = octomap::ColorOcTree(resolution).getClampingThresMaxLog();
+    for (const Point& point : blockSurfacePoints(map.blocks(), resolution)) {
+      const Eigen::Vector3d centre = toPoint3dPrecision(point.cast<double>());
+      visit(centre, occupied, planeAt(map.blocks(), centre, resolution));
+    }
   }
+}
+
+std::unique_ptr<octomap::ColorOcTree> colouredOctree(const Map& map) {
+  auto tree = std::make_unique<octomap::ColorOcTree>(occupiedVoxelSize(map));
+  forEachOccupiedVoxel(map, [&tree](const Eigen::Vector3d& centre, float log_odds, std::int32_t plane) {
+    addVoxel(*tree, toPoint3d(centre), log_odds, plane);
+  });
   // Inner nodes get their children's maximum occupancy and mean colour, so octovis
   // shows coarser levels of detail in the right colours.
   tree->updateInnerOccupancy();
