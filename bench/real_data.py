@@ -33,7 +33,7 @@ def data_sets(data, out):
             with bz2.open(octomap, "rt") as packed, open(xyz + ".part", "w") as unpacked:
                 unpacked.write(packed.read())
             os.replace(xyz + ".part", xyz)
-        sets.append(("fr079", [xyz], [], "OctoMap's scan.dat: one 3D scan of 88,206 points over 27 x 32 x 11 m"))
+        sets.append(("fr079", [xyz], ["--identity"], "OctoMap's scan.dat: one 3D scan of 88,206 points over 27 x 32 x 11 m"))
     bobkov = os.path.join(data, "bobkov_office_labels", "room2_gt_fine.pcd")
     if os.path.exists(bobkov):
         sets.append(("office", [bobkov], [], "Bobkov et al. room 2: a registered mobile-scanner cloud of 123,692 points, z 1.5-3.4 m"))
