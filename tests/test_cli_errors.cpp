@@ -20,8 +20,8 @@ namespace {
 // A 6 × 4 × 2.5 m room scanned from (0, 0, 0): floor 1 m below, by rays spread over the
 // sphere; plus a scanner's junk: readings off its housing (0.15 m) and no-return
 // readings at 32.76 m, as 3DTK's scans hold.
-mlmap::Scan roomScan(bool with_junk) {
-  const Eigen::Vector3d low(-2.0, -3.0, -1.0), high(4.0, 1.0, 1.5);
+mlmap::Scan roomScan(bool with_junk, const Eigen::Vector3d& low = {-2.0, -3.0, -1.0},
+                     const Eigen::Vector3d& high = {4.0, 1.0, 1.5}) {
   mlmap::Scan scan;
   const int rays = 30000;
   const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
@@ -170,7 +170,10 @@ TEST_CASE("CLI: the range limits keep a scanner's junk readings out of the map")
 
 TEST_CASE("CLI: a y-up cloud is warned about, and --up auto or --up y turns it z-up") {
   mlmap::test::TempDir dir;
-  mlmap::Scan room = roomScan(false);
+  // An office of 10 × 8 m: floor and ceiling outweigh the walls, as in most rooms (a
+  // corridor's walls do not, and are not warned about).
+  const Eigen::Vector3d low(-4.0, -4.0, -1.0), high(6.0, 4.0, 1.5);
+  mlmap::Scan room = roomScan(false, low, high);
   for (mlmap::Point& point : room.points) point = mlmap::Point(point.x(), point.z(), -point.y());  // z up -> y up
   const std::string scan = (dir / "yup.xyz").string(), map = (dir / "yup.mlmap").string();
   mlmap::io::writeXyz(scan, room);
@@ -187,7 +190,7 @@ TEST_CASE("CLI: a y-up cloud is warned about, and --up auto or --up y turns it z
     CHECK(bounds["min"][2].get<double>() == doctest::Approx(-1.0).epsilon(0.1));
   }
   // A z-up cloud gives no warning.
-  mlmap::io::writeXyz(scan, roomScan(false));
+  mlmap::io::writeXyz(scan, roomScan(false, low, high));
   result = runCli("--quiet build --identity --no-octree -o " + map + " " + scan);
   CHECK_FALSE(mlmap::test::contains(result.output, "warning"));
 }
