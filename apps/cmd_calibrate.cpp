@@ -5,7 +5,10 @@
 #include "commands.hpp"
 #include "mlmap/error.hpp"
 #include "mlmap/io/scan_file.hpp"
+#include "mlmap/io/scan_input.hpp"
 #include "mlmap/registration/floor_calibration.hpp"
+#include "number_options.hpp"
+#include "output_check.hpp"
 
 namespace mlmap::cli {
 namespace {
@@ -14,11 +17,14 @@ struct CalibrateOptions {
   std::string scan;
   std::string output;
   registration::FloorCalibrationConfig config;
+  io::RangeLimits range;
 };
 
 int runCalibrate(const CalibrateOptions& options) {
-  const std::vector<Scan> scans = io::readScans(options.scan);
+  checkWritable(options.output);
+  std::vector<Scan> scans = io::readScans(options.scan);
   if (scans.empty()) throw Error(options.scan + ": no scan");
+  io::applyRangeLimits(scans.front(), options.range);
   const registration::FloorCalibration calibration =
       registration::calibrateFromFloor(scans.front().points, options.config);
   registration::writeMountCorrection(options.output, calibration);
@@ -37,15 +43,19 @@ void addCalibrateCommand(CLI::App& app, Context& context) {
   auto* command = app.add_subcommand(
       "calibrate", "Find the scanner's inclination from a floor scan; write the tilt correction (JSON)");
   command->add_option("-o,--output", options->output, "Mount correction to write (JSON)")->required();
-  command->add_option("--max-tilt", options->config.max_tilt_deg, "Search the floor within this of level, deg")
-      ->default_val(20.0)
-      ->check(CLI::Range(0.1, 60.0));
-  command->add_option("--inlier-distance", options->config.inlier_distance, "Floor point distance, m")
-      ->default_val(0.03)
-      ->check(CLI::PositiveNumber);
+  addNumber(command, "--max-tilt", options->config.max_tilt_deg, "Search the floor within this of level, deg", 0.1,
+            Bound::Closed, 60.0)
+      ->default_val(20.0);
+  addNumber(command, "--inlier-distance", options->config.inlier_distance, "Floor point distance, m", 0.0, Bound::Open)
+      ->default_val(0.03);
+  addNumber(command, "--min-range", options->range.min, "Drop readings nearer than this to the scanner, m", 0.0,
+            Bound::Closed)
+      ->capture_default_str();
+  addNumber(command, "--max-range", options->range.max, "Drop readings farther than this from the scanner, m", 0.0,
+            Bound::Open)
+      ->capture_default_str();
   command->add_option("scan", options->scan, "Scan of the floor around the robot, sensor frame (first scan of the file)")
-      ->required()
-      ->check(CLI::ExistingFile);
+      ->required();
   command->callback([options, &context] { context.run = [options] { return runCalibrate(*options); }; });
 }
 

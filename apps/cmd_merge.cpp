@@ -11,6 +11,7 @@
 #include "mlmap/io/transform_file.hpp"
 #include "mlmap/map/merge.hpp"
 #include "mlmap/registration/map_registration.hpp"
+#include "output_check.hpp"
 
 namespace mlmap::cli {
 namespace {
@@ -40,6 +41,7 @@ void printTransform(const char* what, const Pose& pose) {
 
 int runMerge(const MergeArguments& arguments, bool quiet) {
   const auto start = std::chrono::steady_clock::now();
+  checkWritable(arguments.output);
   if (!quiet) std::fprintf(stderr, "merge: reading %s and %s ...\n", arguments.base.c_str(), arguments.other.c_str());
   Map base = io::readMap(arguments.base);
   const Map other = io::readMap(arguments.other);

@@ -4,7 +4,9 @@
 #include "commands.hpp"
 #include "mlmap/io/map_file.hpp"
 #include "mlmap/io/planes_json.hpp"
-#include "mlmap/planes/ermsm.hpp"
+#include "mlmap/map/map_planes.hpp"
+#include "number_options.hpp"
+#include "output_check.hpp"
 
 namespace mlmap::cli {
 namespace {
@@ -17,19 +19,24 @@ struct PlanesArguments {
 };
 
 int runPlanes(const PlanesArguments& arguments, bool quiet) {
+  if (!arguments.json.empty()) checkWritable(arguments.json);
+  if (!arguments.output.empty()) checkWritable(arguments.output);
   Map map = io::readMap(arguments.map);
-  if (!quiet) std::fprintf(stderr, "planes: %zu blocks ...\n", map.blocks().blockCount());
-  map.setPlanes(detectPlanes(map.blocks(), arguments.config));
-  const PlaneDetection& detection = *map.planes();
+  const std::size_t blocks = map.blocks().blockCount();
+  if (!quiet) std::fprintf(stderr, "planes: %zu blocks ...\n", blocks);
+  const PlaneDetection& detection = detectPlanes(map, arguments.config);
   if (!arguments.json.empty()) io::writePlanesJson(arguments.json, map, detection, arguments.map);
   // The map carries its planes, so `mlmap export` needs no second detection run.
   if (!arguments.output.empty()) io::writeMap(arguments.output, map);
   const ErmsmStats& stats = detection.stats;
-  std::printf("%s: %zu blocks, %zu planes (%zu patches) from %zu candidates in %.3f s "
-              "(direction vectors %.3f s, detection %.3f s); %zu blocks labelled\n",
-              arguments.map.c_str(), stats.blocks, stats.accepted, detection.planes.size(),
-              stats.candidates, stats.direction_seconds + stats.detection_seconds,
-              stats.direction_seconds, stats.detection_seconds, stats.labelled_blocks);
+  // The map's blocks, labelled ones included (eRMSM joins a cell's stacked blocks into
+  // fewer of its own: the JSON's detection.blocks).
+  std::printf("%s: %zu blocks, %zu of them labelled (%.1f %%); %zu planes (%zu patches) from %zu candidates in "
+              "%.3f s (direction vectors %.3f s, detection %.3f s)\n",
+              arguments.map.c_str(), blocks, stats.labelled_blocks,
+              blocks == 0 ? 0.0 : 100.0 * static_cast<double>(stats.labelled_blocks) / static_cast<double>(blocks),
+              stats.accepted, detection.planes.size(), stats.candidates,
+              stats.direction_seconds + stats.detection_seconds, stats.direction_seconds, stats.detection_seconds);
   // The parameters the run used, resolved ones (ε, σ) included: the JSON has them all.
   const ErmsmConfig& used = detection.config;
   std::printf("  parameters: r %d cells, ε %.3f m, σ %.4f m, κ %g°, θ %g°, p_t %g, s_m %g m², "
@@ -62,31 +69,45 @@ void addPlanesCommand(CLI::App& app, Context& context) {
   command->add_option("--json", arguments->json, "Write the planes (schema mlmap.planes/1)");
   command->add_option("-o,--output", arguments->output, "Write the map with its blocks labelled");
   command->add_option("--seed", config.seed, "Random seed (same seed, same planes)")->capture_default_str();
-  command->add_option("--threads", config.threads, "Threads (default: all cores)")->check(CLI::NonNegativeNumber);
-  command->add_option("--radius", config.radius, "r: neighbourhood radius, cells")
-      ->capture_default_str()->check(CLI::PositiveNumber);
-  command->add_option("--epsilon", config.epsilon, "ε: max block-plane distance, m (default: max(3 σ, min(cell size, 0.05)); maps without point moments: max(cell size, min(3 σ, 0.05)))")
-      ->check(CLI::NonNegativeNumber);
-  command->add_option("--noise", config.noise, "σ: range noise of the map's points, m (default: from its vertical blocks)")
-      ->check(CLI::NonNegativeNumber);
-  command->add_option("--stack-gap", config.stack_gap, "A cell's blocks closer than this are one eRMSM block, m")
-      ->capture_default_str()->check(CLI::NonNegativeNumber);
-  command->add_option("--ladder-gap", config.ladder_gap,
-                      "A ladder of short blocks of a cell less than this apart is one eRMSM block (sparse scan lines), m; 0 = off")
-      ->capture_default_str()->check(CLI::NonNegativeNumber);
-  command->add_option("--ladder-blocks", config.ladder_blocks, "Blocks a ladder needs at least")
-      ->capture_default_str()->check(CLI::Range(2, 1000));
-  command->add_option("--kappa", config.kappa_deg, "κ: max angle block direction / plane normal, deg")->capture_default_str();
-  command->add_option("--theta", config.theta_deg, "θ: max angle between the seeds' directions, deg")->capture_default_str();
-  command->add_option("--probability", config.min_probability, "p_t: acceptance probability (eq. 10)")->capture_default_str();
-  command->add_option("--acceptance-exponent", config.acceptance_exponent,
-                      "k of eq. 10, P = (s_c/s_o)^k: the paper's 3, or 1 (default: only the first seed is drawn from the whole map)")
+  addNumber(command, "--threads", config.threads, "Threads (default: all cores)", 0, Bound::Closed);
+  addNumber(command, "--radius", config.radius, "r: neighbourhood radius, cells", 1, Bound::Closed, 50)
       ->capture_default_str();
-  command->add_option("--min-area", config.min_area, "s_m: minimal plane surface, m²")->capture_default_str();
-  command->add_option("--min-patch-area", config.min_patch_area, "Smaller connected patches are dropped, m²")->capture_default_str();
-  command->add_option("--max-candidates", config.max_candidates, "Max_cp: candidates in all")->capture_default_str();
-  command->add_option("--max-idle-candidates", config.max_idle_candidates,
-                      "Stop after this many candidates without an accepted plane")->capture_default_str();
+  addNumber(command, "--epsilon", config.epsilon,
+            "ε: max block-plane distance, m (default: max(3 σ, min(cell size, 0.05)); maps without point moments: max(cell size, min(3 σ, 0.05)))", 0.0, Bound::Closed, 10.0);
+  addNumber(command, "--noise", config.noise, "σ: range noise of the map's points, m (default: from its vertical blocks)",
+            0.0, Bound::Closed, 10.0);
+  addNumber(command, "--stack-gap", config.stack_gap, "A cell's blocks closer than this are one eRMSM block, m", 0.0,
+            Bound::Closed)
+      ->capture_default_str();
+  addNumber(command, "--ladder-gap", config.ladder_gap,
+            "A ladder of short blocks of a cell less than this apart is one eRMSM block (sparse scan lines), m; 0 = off",
+            0.0, Bound::Closed)
+      ->capture_default_str();
+  addNumber(command, "--ladder-blocks", config.ladder_blocks, "Blocks a ladder needs at least", 2, Bound::Closed, 1000)
+      ->capture_default_str();
+  addNumber(command, "--kappa", config.kappa_deg, "κ: max angle block direction / plane normal, deg", 0.0, Bound::Open,
+            90.0)
+      ->capture_default_str();
+  addNumber(command, "--theta", config.theta_deg, "θ: max angle between the seeds' directions, deg", 0.0, Bound::Open,
+            90.0)
+      ->capture_default_str();
+  addNumber(command, "--probability", config.min_probability, "p_t: acceptance probability (eq. 10)", 0.0, Bound::Open,
+            1.0)
+      ->capture_default_str();
+  addNumber(command, "--acceptance-exponent", config.acceptance_exponent,
+            "k of eq. 10, P = (s_c/s_o)^k: the paper's 3, or 1 (default: only the first seed is drawn from the whole map)",
+            0.0, Bound::Open, 10.0)
+      ->capture_default_str();
+  addNumber(command, "--min-area", config.min_area, "s_m: minimal plane surface, m²", 0.0, Bound::Closed)
+      ->capture_default_str();
+  addNumber(command, "--min-patch-area", config.min_patch_area, "Smaller connected patches are dropped, m²", 0.0,
+            Bound::Closed)
+      ->capture_default_str();
+  addNumber(command, "--max-candidates", config.max_candidates, "Max_cp: candidates in all", 1, Bound::Closed)
+      ->capture_default_str();
+  addNumber(command, "--max-idle-candidates", config.max_idle_candidates,
+            "Stop after this many candidates without an accepted plane", 1, Bound::Closed)
+      ->capture_default_str();
   command->callback([arguments, &context] {
     context.run = [arguments, &context] { return runPlanes(*arguments, context.quiet); };
   });

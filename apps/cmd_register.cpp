@@ -8,17 +8,16 @@
 #include "mlmap/io/tum_poses.hpp"
 #include "mlmap/registration/sequence_registration.hpp"
 #include "mlmap/registration/trajectory_error.hpp"
-#include "posed_scans.hpp"
 #include "progress.hpp"
+#include "scan_options.hpp"
 
 namespace mlmap::cli {
 namespace {
 
 struct RegisterOptions {
   std::string output;
-  std::string poses;
+  ScanOptions input;
   std::string reference;
-  std::vector<std::string> scans;
   std::string metric = "point-to-plane";
   bool no_refine = false;
   registration::SequenceConfig config;
@@ -38,20 +37,22 @@ void printError(const char* label, const std::vector<Pose>& poses, const std::ve
 int runRegister(RegisterOptions options, bool quiet) {
   options.config.icp.metric = options.metric == "point-to-point" ? registration::IcpMetric::PointToPoint
                                                                    : registration::IcpMetric::PointToPlane;
-  std::vector<io::StampedPose> odometry;
-  if (!options.poses.empty()) odometry = io::readTumPoses(options.poses);
+  checkWritable(options.output);
+  options.input.identity = true;  // without odometry, registration starts from each scan's own pose
+  const ScanReading reading(options.input, "register", quiet);
+  const std::vector<io::StampedPose>& odometry = reading.sequence().poses();
+  options.config.min_range = options.input.range.min;
+  options.config.max_range = options.input.range.max;
 
   registration::SequenceRegistration sequence(options.config);
   std::vector<io::StampedPose> stamped;
   std::vector<Pose> odometry_poses;
   double register_seconds = 0.0;
   std::size_t point_count = 0;
-  Progress progress("register", options.scans.size(), !quiet);
-  forEachPosedScan(
-      options.scans, odometry, options.poses,
+  Progress progress("register", options.input.scans.size(), !quiet);
+  reading.forEach(
       [&](Scan& scan, std::size_t index, std::size_t) {
-        const io::StampedPose guess = odometry.empty() ? io::StampedPose{static_cast<double>(index), scan.pose}
-                                                       : odometry[index];
+        const io::StampedPose guess{odometry.empty() ? static_cast<double>(index) : odometry[index].stamp, scan.pose};
         const auto start = std::chrono::steady_clock::now();
         const registration::IcpResult result = sequence.addScan(scan.points, guess.pose);
         register_seconds += secondsSince(start);
@@ -100,8 +101,6 @@ void addRegisterCommand(CLI::App& app, Context& context) {
   auto* command = app.add_subcommand(
       "register", "Correct odometry poses by ICP: scan-to-map, then a pose graph over overlapping pairs");
   command->add_option("-o,--output", options->output, "Corrected poses to write (TUM)")->required();
-  command->add_option("--poses", options->poses,
-                      "Odometry poses (TUM), one per scan in order; without it each scan's own pose");
   command->add_option("--reference", options->reference,
                       "Reference poses (TUM, same world frame) to print the absolute trajectory error");
   command->add_option("--metric", options->metric, "ICP error metric")
@@ -119,14 +118,10 @@ void addRegisterCommand(CLI::App& app, Context& context) {
                       "Initial correspondence distance, m: a bound on the odometry error")
       ->default_val(0.5)
       ->check(CLI::PositiveNumber);
-  command->add_option("--max-range", options->config.max_range, "Drop points farther than this, m")
-      ->default_val(30.0)
-      ->check(CLI::PositiveNumber);
   command->add_flag("--no-refine", options->no_refine, "Scan-to-map only, no pose graph");
-  command->add_option("scans", options->scans,
-                      "Scan files in order: .xyz .txt .pts .ply .pcd .3d (3DTK) .graph (OctoMap)")
-      ->required()
-      ->check(CLI::ExistingFile);
+  addScanOptions(command, options->input,
+                 {.poses_help = "Odometry poses (TUM), one per scan in order; without it each scan's own pose",
+                  .identity = false});
   command->callback([options, &context] {
     context.run = [options, &context] { return runRegister(*options, context.quiet); };
   });

@@ -5,10 +5,12 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <string>
 
 #include "commands.hpp"
 #include "passive_wait.hpp"
 #include "mlmap/error.hpp"
+#include "mlmap/io/atomic_file.hpp"
 
 namespace {
 
@@ -25,11 +27,21 @@ void keepFreedMemory() {
 #endif
 }
 
+// One line in one style for every error: CLI11's messages may hold line breaks.
+std::string oneLine(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   mlmap::cli::preferPassiveWaiting(argv);
   keepFreedMemory();
+  mlmap::io::removeTemporaryFilesOnSignal();
   CLI::App app{"mlmap: Multi-Level maps from 3D laser scans, and the planes in them"};
   app.set_version_flag("--version", "mlmap 0.1.0");
   app.require_subcommand(1);
@@ -40,15 +52,23 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
-    return app.exit(error);
+    // --help and --version end parsing too, successfully.
+    if (error.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(error);
+    // CLI11 reports a typo'd command as "A subcommand is required": name the word instead.
+    if (app.get_subcommands().empty() && argc > 1) {
+      for (int k = 1; k < argc; ++k) {
+        if (argv[k][0] == '-') continue;
+        std::cerr << "mlmap: '" << argv[k] << "' is not a command (see mlmap --help)\n";
+        return 1;
+      }
+    }
+    std::cerr << "mlmap: " << oneLine(error.what()) << " (see mlmap --help)\n";
+    return 1;
   }
   try {
     return context.run();
-  } catch (const mlmap::Error& error) {
-    std::cerr << "mlmap: " << error.what() << "\n";
+  } catch (const std::exception& error) {  // mlmap::Error names the file; anything else is a failure too
+    std::cerr << "mlmap: " << oneLine(error.what()) << "\n";
     return 1;
-  } catch (const std::exception& error) {
-    std::cerr << "mlmap: " << error.what() << "\n";
-    return 2;
   }
 }

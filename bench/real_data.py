@@ -124,8 +124,13 @@ def score(labels, owner, points, planes, annotation):
 
 def run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features):
     tag = os.path.join(folder, f"cell{cell:g}")
-    posed = ["--poses", pose_file] if pose_file else []
-    build = [mlmap, "-q", "build", "-o", tag + ".mlmap", "--cell-size", str(cell), "--no-octree"] + posed + up_options
+    # World-frame clouds (no sensor pose) are mapped as they are: --identity where the CLI
+    # asks for it. The benchmark drops a scanner's own and no-return readings itself
+    # (real_clouds.py), so mlmap's range limits are opened wide.
+    posed = ["--poses", pose_file] if pose_file else (["--identity"] if "--identity" in features["build"] else [])
+    wide = (["--max-range", "1000"] if "--max-range" in features["build"] else []) + \
+           (["--min-range", "0"] if "--min-range" in features["build"] else [])
+    build = [mlmap, "-q", "build", "-o", tag + ".mlmap", "--cell-size", str(cell), "--no-octree"] + posed + up_options + wide
     _, build_s = run(build + files)
     run([mlmap, "-q", "planes", tag + ".mlmap", "--threads", "2", "-o", tag + ".planes.mlmap", "--json", tag + ".planes.json"])
     planes_json = json.load(open(tag + ".planes.json"))

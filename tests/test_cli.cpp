@@ -82,7 +82,7 @@ TEST_CASE("CLI: bad input ends with one line naming the file, exit code 1, no ou
   }
   SUBCASE("a scan with a NaN on line 3") {
     mlmap::test::writeText(dir / "bad.xyz", "0 0 0\n1 1 1\n1 nan 1\n");
-    result = runCli("--quiet build -o " + map + " " + (dir / "bad.xyz").string());
+    result = runCli("--quiet build --identity -o " + map + " " + (dir / "bad.xyz").string());
     CHECK(result.exit_code == 1);
     CHECK(lineCount(result.output) == 1);
     CHECK(result.output.find("bad.xyz:3") != std::string::npos);

@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "helpers.hpp"
+#include "mlmap/io/atomic_file.hpp"
 #include "mlmap/io/map_file.hpp"
 #include "mlmap/io/scan_file.hpp"
 #include "mlmap/map/map.hpp"
@@ -129,4 +130,33 @@ TEST_CASE("Crash-safe writes: SIGKILL while a large map is written keeps the old
     CHECK_THROWS_AS(io::readScans(temporary), Error);
   }
   CHECK_MESSAGE(interrupted, "the writer finished every time before it could be killed");
+}
+
+TEST_CASE("Crash-safe writes: SIGINT or SIGTERM during a write removes its temporary file") {
+  for (const int signal_number : {SIGINT, SIGTERM}) {
+    test::TempDir dir;
+    const fs::path path = dir / "out.xyz";
+    const pid_t child = ::fork();
+    REQUIRE(child >= 0);
+    if (child == 0) {
+      io::removeTemporaryFilesOnSignal();
+      try {
+        // The signal arrives with the temporary file created and half written.
+        io::writeAtomically(path, [&](std::ostream& out) {
+          out << "0 0 0\n";
+          out.flush();
+          ::raise(signal_number);
+          out << "1 1 1\n";
+        });
+      } catch (...) {
+      }
+      ::_exit(0);  // not reached: the signal ends the child
+    }
+    int status = 0;
+    REQUIRE(::waitpid(child, &status, 0) == child);
+    CHECK(WIFSIGNALED(status));
+    CHECK(WTERMSIG(status) == signal_number);
+    CHECK_FALSE(otherFile(dir.path(), path).has_value());  // no .out.xyz.PID.0.tmp
+    CHECK_FALSE(fs::exists(path));
+  }
 }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <fstream>
 #include <string>
 
 #include "mlmap/error.hpp"
@@ -40,12 +41,38 @@ std::vector<Scan> single(Scan scan) {
   return scans;
 }
 
+void requireRegularFile(const std::filesystem::path& path) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
+  if (std::filesystem::is_directory(path, error)) throw Error(path.string() + ": is a directory, not a scan file");
+}
+
+// Reads the header lines only (up to DATA, at most 64 KB): readPcd parses them properly.
+bool pcdHeaderHasViewpoint(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  std::size_t read = 0;
+  while (read < (64u << 10) && std::getline(in, line)) {
+    read += line.size() + 1;
+    if (line.rfind("VIEWPOINT", 0) == 0) return true;
+    if (line.rfind("DATA", 0) == 0) return false;
+  }
+  return false;
+}
+
 }  // namespace
+
+ScanFileKind scanFileKind(const std::filesystem::path& path) {
+  const Format format = formatOf(path);
+  requireRegularFile(path);
+  return ScanFileKind{.single_scan = format != Format::Graph,
+                      .carries_pose = format == Format::ThreeDtk || format == Format::Graph ||
+                                      (format == Format::Pcd && pcdHeaderHasViewpoint(path))};
+}
 
 std::vector<Scan> readScans(const std::filesystem::path& path) {
   const Format format = formatOf(path);
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
+  requireRegularFile(path);
   switch (format) {
     case Format::Xyz:
       return single(readXyz(path));

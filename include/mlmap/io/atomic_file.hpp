@@ -16,4 +16,9 @@ namespace mlmap::io {
 void writeAtomically(const std::filesystem::path& path,
                      const std::function<void(std::ostream&)>& write);
 
+// Installs SIGINT and SIGTERM handlers that remove the temporary file of a write in
+// progress, then end the process as the signal would have (for programs such as the
+// CLI: Ctrl-C during a long write leaves no hidden .NAME.PID.N.tmp behind).
+void removeTemporaryFilesOnSignal();
+
 }  // namespace mlmap::io

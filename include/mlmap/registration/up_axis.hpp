@@ -1,0 +1,46 @@
+// Which way is up. The ML map stacks its blocks along z and eRMSM's classes read
+// heights (section IV, V-D), so a cloud whose world frame is not z-up (a camera's
+// y-down frame turned by its VIEWPOINT, a sensor mounted on its side) maps walls as
+// floors. The up axis is found in the data, among the six signed coordinate axes:
+//  1. the line: when the scans' rotations differ, the axis they turn about (a robot
+//     turns about up only); else the axis the most planar cells face (floors and
+//     ceilings, desks and seats; walls split between two axes);
+//  2. the sign: of the points on that family's planes, more lie below their sensor
+//     (floor, table tops, seats: a scanner is mounted, a camera held, nearer the floor
+//     than the ceiling, and denser readings fall on the nearer surface).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+#include "mlmap/scan.hpp"
+
+namespace mlmap::registration {
+
+enum class UpCue { None, Poses, Planes };
+
+struct UpAxisEstimate {
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // a signed coordinate axis, world frame
+  UpCue line_from = UpCue::None;  // None: too few planar cells and no turn (then up stays +z)
+  double planar_share = 0.0;      // of the planar cells, the share facing the up line
+  double below_share = 0.0;       // of the points on those cells, the share below their sensor
+  std::size_t planar_cells = 0;
+};
+
+struct UpAxisConfig {
+  double cell_size = 0.2;          // m, the cells whose points are fitted a plane
+  std::size_t max_points = 200000; // the scans are thinned evenly to at most this many
+};
+
+// From scans in their sensor frames with their world poses (the sensor origins).
+UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig& config = {});
+
+// The rotation turning `up` (a signed coordinate axis) into +z: identity, a quarter
+// turn about x or y, or a half turn about x.
+Eigen::Matrix3d rotationToZUp(const Eigen::Vector3d& up);
+
+// "+z", "-y", ...: the axis as the CLI's --up names it.
+const char* axisName(const Eigen::Vector3d& up);
+
+}  // namespace mlmap::registration

@@ -1,0 +1,101 @@
+#include "mlmap/io/scan_input.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "mlmap/error.hpp"
+#include "mlmap/io/scan_file.hpp"
+
+namespace mlmap::io {
+namespace {
+
+std::string noPoseMessage(const std::filesystem::path& file) {
+  return file.string() + ": the scan carries no pose; give --poses, or --identity to map it at the origin";
+}
+
+}  // namespace
+
+std::size_t applyRangeLimits(Scan& scan, const RangeLimits& limits) {
+  const bool with_variances = scan.variances.size() == scan.size();
+  const bool with_labels = scan.labels.size() == scan.size();
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < scan.size(); ++k) {
+    if (!limits.contains(scan.points[k])) continue;
+    scan.points[kept] = scan.points[k];
+    if (with_variances) scan.variances[kept] = scan.variances[k];
+    if (with_labels) scan.labels[kept] = scan.labels[k];
+    ++kept;
+  }
+  const std::size_t dropped = scan.size() - kept;
+  scan.points.resize(kept);
+  if (with_variances) scan.variances.resize(kept);
+  if (with_labels) scan.labels.resize(kept);
+  return dropped;
+}
+
+ScanSequence::ScanSequence(ScanInput input) : input_(std::move(input)) {
+  const RangeLimits& range = input_.range;
+  if (!(range.min >= 0.0) || !(range.max > range.min)) {
+    throw Error("range limits: need 0 <= minimum < maximum, got " + std::to_string(range.min) + " and " +
+                std::to_string(range.max) + " m");
+  }
+  if (input_.files.empty()) throw Error("no scan files");
+  bool counted = true;  // every file holds one scan
+  for (const std::filesystem::path& file : input_.files) {
+    const ScanFileKind kind = scanFileKind(file);
+    counted = counted && kind.single_scan;
+    if (input_.poses.empty() && !input_.identity && !kind.carries_pose) throw Error(noPoseMessage(file));
+  }
+  if (input_.poses.empty()) return;
+  poses_ = readTumPoses(input_.poses);
+  if (counted && poses_.size() != input_.files.size()) {
+    throw Error(input_.poses.string() + ": " + std::to_string(poses_.size()) + " poses for " +
+                std::to_string(input_.files.size()) + " scans");
+  }
+}
+
+ScanSequence ScanSequence::withPoses(std::vector<StampedPose> poses) const {
+  ScanSequence copy = *this;
+  copy.poses_ = std::move(poses);
+  copy.input_.world = Pose::Identity();
+  copy.input_.poses = copy.input_.poses.empty() ? std::filesystem::path("the corrected poses") : copy.input_.poses;
+  return copy;
+}
+
+ScanInputCounts ScanSequence::forEach(const Visit& visit, const std::function<void(std::size_t file)>& file_done,
+                                      std::size_t max_files) const {
+  ScanInputCounts counts;
+  const double min_squared = input_.range.min * input_.range.min;
+  const std::size_t files = std::min(max_files, input_.files.size());
+  for (std::size_t file = 0; file < files; ++file) {
+    for (Scan& scan : readScans(input_.files[file])) {
+      const std::size_t index = counts.scans;
+      if (!poses_.empty()) {
+        if (index >= poses_.size()) {
+          throw Error(input_.poses.string() + ": " + std::to_string(poses_.size()) +
+                      " poses, but there are more scans (" + input_.files[file].string() + " is scan " +
+                      std::to_string(index + 1) + ")");
+        }
+        scan.pose = poses_[index].pose;
+      }
+      for (const Point& point : scan.points) {
+        if (input_.range.contains(point)) continue;
+        ++(point.squaredNorm() < min_squared ? counts.too_near : counts.too_far);
+      }
+      applyRangeLimits(scan, input_.range);
+      scan.pose = input_.world * scan.pose;
+      counts.points += scan.size();
+      ++counts.scans;
+      visit(scan, index, file);
+    }
+    if (file_done) file_done(file);
+  }
+  if (files == input_.files.size() && !poses_.empty() && counts.scans != poses_.size()) {
+    throw Error(input_.poses.string() + ": " + std::to_string(poses_.size()) + " poses for " +
+                std::to_string(counts.scans) + " scans");
+  }
+  return counts;
+}
+
+}  // namespace mlmap::io

@@ -1,0 +1,138 @@
+#include "mlmap/registration/up_axis.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <Eigen/Geometry>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <unordered_map>
+
+namespace mlmap::registration {
+namespace {
+
+// A cell's points: their moments, and per axis how many lie below their sensor.
+struct CellSums {
+  std::size_t count = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  std::array<std::size_t, 3> below{};
+};
+
+// Fewer points do not fix a plane against the noise; a cell of 0.2 m holds hundreds
+// on a surface a few metres off.
+constexpr std::size_t kMinCellPoints = 8;
+// Flat: the smallest spread under a fifth of the middle one (σ_min/σ_mid < 0.22): a
+// plane with a few cm of noise in a 0.2 m cell, not a corner or a chair leg.
+constexpr double kFlatness = 0.05;
+// A cell faces an axis within 15 deg; a turn counts from 10 deg (under it, the axis of
+// a turn is the noise of the poses).
+const double kFacingCos = std::cos(15.0 * std::numbers::pi / 180.0);
+constexpr double kMinTurnRad = 10.0 * std::numbers::pi / 180.0;
+const double kSnapCos = std::cos(10.0 * std::numbers::pi / 180.0);
+constexpr std::size_t kMinPlanarCells = 20;
+
+std::uint64_t cellKey(const Eigen::Vector3d& point, double cell_size) {
+  const auto part = [&](double value) {
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(value / cell_size)) + (1 << 20)) & 0x1FFFFF;
+  };
+  return part(point.x()) | part(point.y()) << 21 | part(point.z()) << 42;
+}
+
+// The coordinate axis (0, 1, 2) within kSnapCos of `direction`, or -1.
+int snappedAxis(const Eigen::Vector3d& direction) {
+  Eigen::Index axis = 0;
+  const double largest = direction.cwiseAbs().maxCoeff(&axis);
+  return largest >= kSnapCos * direction.norm() ? static_cast<int>(axis) : -1;
+}
+
+// The axis the scans turn about, when they turn: their rotations relative to the first.
+int turnAxis(const std::vector<Scan>& scans) {
+  Eigen::Vector3d summed = Eigen::Vector3d::Zero();
+  for (std::size_t k = 1; k < scans.size(); ++k) {
+    const Eigen::AngleAxisd turn(scans[k].pose.linear() * scans.front().pose.linear().transpose());
+    if (turn.angle() < kMinTurnRad) continue;
+    const Eigen::Vector3d axis = turn.axis().dot(summed) < 0.0 ? Eigen::Vector3d(-turn.axis()) : turn.axis();
+    summed += turn.angle() * axis;
+  }
+  return summed.norm() > 0.0 ? snappedAxis(summed) : -1;
+}
+
+}  // namespace
+
+UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig& config) {
+  std::size_t total = 0;
+  for (const Scan& scan : scans) total += scan.size();
+  const std::size_t stride = config.max_points == 0 ? 1 : std::max<std::size_t>(1, total / config.max_points + 1);
+  std::unordered_map<std::uint64_t, CellSums> cells;
+  std::size_t running = 0;
+  for (const Scan& scan : scans) {
+    const Eigen::Vector3d origin = scan.pose.translation();
+    for (const Point& sensor_point : scan.points) {
+      if (running++ % stride != 0) continue;
+      const Eigen::Vector3d point = scan.pose * sensor_point;
+      CellSums& cell = cells[cellKey(point, config.cell_size)];
+      ++cell.count;
+      cell.sum += point;
+      cell.outer += point * point.transpose();
+      for (int axis = 0; axis < 3; ++axis) cell.below[axis] += point[axis] < origin[axis] ? 1 : 0;
+    }
+  }
+
+  // Planar cells by the axis they face (-1: none), with their points.
+  std::array<std::size_t, 3> facing{}, below{}, on_family{};
+  UpAxisEstimate estimate;
+  for (const auto& [key, cell] : cells) {
+    if (cell.count < kMinCellPoints) continue;
+    const double n = static_cast<double>(cell.count);
+    const Eigen::Vector3d mean = cell.sum / n;
+    const Eigen::Matrix3d covariance = cell.outer / n - mean * mean.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+    const Eigen::Vector3d values = solver.eigenvalues();  // ascending
+    if (!(values(0) < kFlatness * values(1))) continue;
+    ++estimate.planar_cells;
+    const Eigen::Vector3d normal = solver.eigenvectors().col(0);
+    Eigen::Index axis = 0;
+    if (normal.cwiseAbs().maxCoeff(&axis) < kFacingCos) continue;
+    ++facing[static_cast<std::size_t>(axis)];
+    on_family[static_cast<std::size_t>(axis)] += cell.count;
+    below[static_cast<std::size_t>(axis)] += cell.below[static_cast<std::size_t>(axis)];
+  }
+
+  int line = turnAxis(scans);
+  if (line >= 0) {
+    estimate.line_from = UpCue::Poses;
+  } else if (estimate.planar_cells >= kMinPlanarCells) {
+    line = static_cast<int>(std::max_element(facing.begin(), facing.end()) - facing.begin());
+    estimate.line_from = UpCue::Planes;
+  } else {
+    return estimate;  // no evidence: +z
+  }
+  const auto axis = static_cast<std::size_t>(line);
+  estimate.planar_share = estimate.planar_cells == 0
+                              ? 0.0
+                              : static_cast<double>(facing[axis]) / static_cast<double>(estimate.planar_cells);
+  estimate.below_share =
+      on_family[axis] == 0 ? 0.5 : static_cast<double>(below[axis]) / static_cast<double>(on_family[axis]);
+  estimate.up = Eigen::Vector3d::Zero();
+  // A tie keeps the positive axis: no evidence against the data's own convention.
+  estimate.up[line] = estimate.below_share >= 0.5 ? 1.0 : -1.0;
+  return estimate;
+}
+
+Eigen::Matrix3d rotationToZUp(const Eigen::Vector3d& up) {
+  const Eigen::Vector3d unit = up.normalized();
+  if (unit.z() > 0.5) return Eigen::Matrix3d::Identity();
+  if (unit.z() < -0.5) return Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  return Eigen::Quaterniond::FromTwoVectors(unit, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
+const char* axisName(const Eigen::Vector3d& up) {
+  Eigen::Index axis = 0;
+  up.cwiseAbs().maxCoeff(&axis);
+  static constexpr std::array<const char*, 6> kNames{"+x", "+y", "+z", "-x", "-y", "-z"};
+  return kNames[static_cast<std::size_t>(axis + (up[axis] < 0.0 ? 3 : 0))];
+}
+
+}  // namespace mlmap::registration

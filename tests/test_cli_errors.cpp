@@ -1,0 +1,217 @@
+// The CLI never gives silent garbage: every error exits 1 with one line in one style
+// ("mlmap: ..."), found before the long work; scans without a pose need --identity.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "cli_runner.hpp"
+#include "helpers.hpp"
+#include "mlmap/io/xyz.hpp"
+
+using mlmap::test::runCli;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A 6 × 4 × 2.5 m room scanned from (0, 0, 0): floor 1 m below, by rays spread over the
+// sphere; plus a scanner's junk: readings off its housing (0.15 m) and no-return
+// readings at 32.76 m, as 3DTK's scans hold.
+mlmap::Scan roomScan(bool with_junk, const Eigen::Vector3d& low = {-2.0, -3.0, -1.0},
+                     const Eigen::Vector3d& high = {4.0, 1.0, 1.5}) {
+  mlmap::Scan scan;
+  const int rays = 30000;
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  for (int k = 0; k < rays; ++k) {
+    const double z = 1.0 - 2.0 * (k + 0.5) / rays;
+    const double radius = std::sqrt(1.0 - z * z);
+    const Eigen::Vector3d direction(radius * std::cos(golden * k), radius * std::sin(golden * k), z);
+    double nearest = 1e9;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (std::abs(direction[axis]) < 1e-12) continue;
+      nearest = std::min(nearest, (direction[axis] > 0 ? high[axis] : low[axis]) / direction[axis]);
+    }
+    scan.points.push_back(nearest * direction);
+    if (with_junk && k % 20 == 0) scan.points.push_back(0.15 * direction);
+    if (with_junk && k % 20 == 10) scan.points.push_back(32.76 * direction);
+  }
+  return scan;
+}
+
+std::size_t lineCount(const std::string& text) {
+  return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+// One line, "mlmap: " first, exit code 1, holding `part`.
+void checkOneLineError(const mlmap::test::CommandResult& result, const std::string& part) {
+  INFO(result.output);
+  CHECK(result.exit_code == 1);
+  CHECK(lineCount(result.output) == 1);
+  CHECK(result.output.rfind("mlmap: ", 0) == 0);
+  CHECK(mlmap::test::contains(result.output, part));
+  CHECK(result.output.size() < 300);  // no 300 digits of DBL_MAX
+}
+
+struct RoomFiles {
+  mlmap::test::TempDir dir;
+  std::string scan = (dir / "room.xyz").string();
+  std::string map = (dir / "room.mlmap").string();
+  RoomFiles() { mlmap::io::writeXyz(scan, roomScan(true)); }
+};
+
+nlohmann::json infoOf(const std::string& map) {
+  const auto result = runCli("info --json " + map);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  return nlohmann::json::parse(result.output);
+}
+
+}  // namespace
+
+TEST_CASE("CLI errors: a scan that carries no pose needs --poses or --identity") {
+  RoomFiles room;
+  checkOneLineError(runCli("--quiet build -o " + room.map + " " + room.scan), "room.xyz: the scan carries no pose");
+  CHECK_FALSE(fs::exists(room.map));
+  checkOneLineError(runCli("--quiet label " + room.map + " -o " + (room.dir / "l.xyz").string() + " " + room.scan),
+                    "carries no pose");
+  const auto result = runCli("--quiet build --identity -o " + room.map + " " + room.scan);
+  CHECK_MESSAGE(result.exit_code == 0, result.output);
+}
+
+TEST_CASE("CLI errors: parse errors, missing files and directories exit 1 with one line") {
+  RoomFiles room;
+  checkOneLineError(runCli("frobnicate"), "frobnicate");
+  checkOneLineError(runCli("build --identity --frobnicate -o " + room.map + " " + room.scan), "--frobnicate");
+  checkOneLineError(runCli(""), "subcommand");
+  checkOneLineError(runCli("build --identity -o " + room.map + " " + (room.dir / "none.xyz").string()),
+                    "none.xyz: no such file");
+  fs::create_directory(room.dir / "folder.xyz");
+  checkOneLineError(runCli("build --identity -o " + room.map + " " + (room.dir / "folder.xyz").string()),
+                    "folder.xyz: is a directory");
+  checkOneLineError(runCli("build --identity -o " + room.map + " " + (room.dir / "scan.las").string()),
+                    "unknown scan format");
+  checkOneLineError(runCli("info " + (room.dir / "none.mlmap").string()), "none.mlmap");
+}
+
+TEST_CASE("CLI errors: numbers parse with a plain message and the paper's parameters are range-checked") {
+  RoomFiles room;
+  checkOneLineError(runCli("build --identity --cell-size abc -o " + room.map + " " + room.scan),
+                    "--cell-size: 'abc' is not a number");
+  checkOneLineError(runCli("build --identity --cell-size -0.1 -o " + room.map + " " + room.scan),
+                    "--cell-size: -0.1 is not in (0, ");
+  checkOneLineError(runCli("build --identity --max-range 1 --min-range 2 -o " + room.map + " " + room.scan),
+                    "range limits");
+  REQUIRE(runCli("--quiet build --identity -o " + room.map + " " + room.scan).exit_code == 0);
+  checkOneLineError(runCli("planes " + room.map + " --probability 2"), "--probability: 2 is not in (0, 1]");
+  checkOneLineError(runCli("planes " + room.map + " --kappa 500"), "--kappa: 500 is not in (0, 90]");
+  checkOneLineError(runCli("planes " + room.map + " --min-area -3"), "--min-area: -3 is not in [0, ");
+  checkOneLineError(runCli("planes " + room.map + " --radius 1.5"), "--radius: '1.5' is not a whole number");
+}
+
+TEST_CASE("CLI errors: pose counts and the output are checked before the long work") {
+  RoomFiles room;
+  mlmap::test::writeText(room.dir / "three.txt", "0 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n");
+  // The second scan is broken: the pose count fails first, so no scan was read.
+  mlmap::test::writeText(room.dir / "broken.xyz", "0 0 nan\n");
+  checkOneLineError(runCli("--quiet build -o " + room.map + " --poses " + (room.dir / "three.txt").string() + " " +
+                           room.scan + " " + (room.dir / "broken.xyz").string()),
+                    "three.txt: 3 poses for 2 scans");
+  checkOneLineError(runCli("--quiet build --identity -o " + (room.dir / "no" / "such" / "m.mlmap").string() + " " +
+                           room.dir.path().string() + "/broken.xyz"),
+                    "m.mlmap: no directory");
+  checkOneLineError(runCli("--quiet build --identity -o " + room.dir.path().string() + " " + room.scan),
+                    "is a directory");
+}
+
+TEST_CASE("CLI errors: label on a map without planes is refused, planes counts one kind of block") {
+  RoomFiles room;
+  REQUIRE(runCli("--quiet build --identity --cell-size 0.1 -o " + room.map + " " + room.scan).exit_code == 0);
+  const std::string labels = (room.dir / "labels.xyz").string();
+  checkOneLineError(runCli("--quiet label --identity " + room.map + " -o " + labels + " " + room.scan),
+                    "has no planes");
+  CHECK_FALSE(fs::exists(labels));
+  const std::string labelled = (room.dir / "labelled.mlmap").string();
+  const auto planes = runCli("--quiet planes " + room.map + " -o " + labelled);
+  REQUIRE_MESSAGE(planes.exit_code == 0, planes.output);
+  // "N blocks, M of them labelled": N is the map's block count, as `mlmap info` says.
+  const std::size_t blocks = infoOf(room.map)["blocks"]["total"].get<std::size_t>();
+  CHECK_MESSAGE(mlmap::test::contains(planes.output, room.map + ": " + std::to_string(blocks) + " blocks, "),
+                planes.output);
+  CHECK(mlmap::test::contains(planes.output, " of them labelled"));
+  const auto label = runCli("--quiet label --identity " + labelled + " -o " + labels + " " + room.scan);
+  CHECK_MESSAGE(label.exit_code == 0, label.output);
+  // Every input point, in order, the junk ones with no plane.
+  const mlmap::Scan written = mlmap::io::readXyz(labels);
+  const mlmap::Scan input = mlmap::io::readXyz(room.scan);
+  REQUIRE(written.size() == input.size());
+  for (std::size_t k = 0; k < input.size(); ++k) {
+    const double range = input.points[k].norm();
+    if (range < 0.4 || range > 30.0) CHECK(written.labels[k] == -1);
+  }
+}
+
+TEST_CASE("CLI: the range limits keep a scanner's junk readings out of the map") {
+  RoomFiles room;
+  REQUIRE(runCli("--quiet build --identity -o " + room.map + " " + room.scan).exit_code == 0);
+  auto bounds = infoOf(room.map)["bounds"];
+  // The room, 6 × 4 × 2.5 m, not the no-return readings' 65 m.
+  CHECK(bounds["max"][0].get<double>() - bounds["min"][0].get<double>() == doctest::Approx(6.0).epsilon(0.05));
+  CHECK(bounds["max"][2].get<double>() - bounds["min"][2].get<double>() == doctest::Approx(2.5).epsilon(0.1));
+  const auto wide = runCli("build --identity --min-range 0 --max-range 40 -o " + room.map + " " + room.scan);
+  REQUIRE_MESSAGE(wide.exit_code == 0, wide.output);
+  bounds = infoOf(room.map)["bounds"];
+  CHECK(bounds["max"][0].get<double>() - bounds["min"][0].get<double>() > 60.0);
+  // Without --quiet, build says how many it dropped.
+  const auto counted = runCli("build --identity -o " + room.map + " " + room.scan);
+  CHECK(mlmap::test::contains(counted.output, "dropped 1500 readings nearer than 0.4 m and 1500 beyond 30 m"));
+}
+
+TEST_CASE("CLI: a y-up cloud is warned about, and --up auto or --up y turns it z-up") {
+  mlmap::test::TempDir dir;
+  // An office of 10 × 8 m: floor and ceiling outweigh the walls, as in most rooms (a
+  // corridor's walls do not, and are not warned about).
+  const Eigen::Vector3d low(-4.0, -4.0, -1.0), high(6.0, 4.0, 1.5);
+  mlmap::Scan room = roomScan(false, low, high);
+  for (mlmap::Point& point : room.points) point = mlmap::Point(point.x(), point.z(), -point.y());  // z up -> y up
+  const std::string scan = (dir / "yup.xyz").string(), map = (dir / "yup.mlmap").string();
+  mlmap::io::writeXyz(scan, room);
+  auto result = runCli("--quiet build --identity --no-octree -o " + map + " " + scan);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  CHECK(mlmap::test::contains(result.output, "warning: the data look y-up, not z-up"));
+  CHECK(mlmap::test::contains(result.output, "--up y"));
+  for (const char* up : {"auto", "y"}) {
+    result = runCli("--quiet build --identity --no-octree --up " + std::string(up) + " -o " + map + " " + scan);
+    REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+    CHECK_FALSE(mlmap::test::contains(result.output, "warning"));
+    const auto bounds = infoOf(map)["bounds"];
+    CHECK(bounds["max"][2].get<double>() - bounds["min"][2].get<double>() == doctest::Approx(2.5).epsilon(0.1));
+    CHECK(bounds["min"][2].get<double>() == doctest::Approx(-1.0).epsilon(0.1));
+  }
+  // A z-up cloud gives no warning.
+  mlmap::io::writeXyz(scan, roomScan(false, low, high));
+  result = runCli("--quiet build --identity --no-octree -o " + map + " " + scan);
+  CHECK_FALSE(mlmap::test::contains(result.output, "warning"));
+}
+
+TEST_CASE("CLI: label and register take --mount as build does") {
+  RoomFiles room;
+  mlmap::test::writeText(room.dir / "mount.json",
+                         R"({"schema": "mlmap.mount/1", "roll_correction_deg": 0, "pitch_correction_deg": 90,)"
+                         R"( "floor_distance": 1, "floor_points": 100})");
+  const std::string mount = " --mount " + (room.dir / "mount.json").string();
+  REQUIRE(runCli("--quiet build --identity -o " + room.map + mount + " " + room.scan).exit_code == 0);
+  const std::string labelled = (room.dir / "labelled.mlmap").string();
+  REQUIRE(runCli("--quiet planes " + room.map + " -o " + labelled).exit_code == 0);
+  const std::string labels = (room.dir / "labels.xyz").string();
+  const auto result = runCli("--quiet label --identity " + labelled + mount + " -o " + labels + " " + room.scan);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  // Pitched by 90 deg about y: x goes to -z.
+  const mlmap::Scan input = mlmap::io::readXyz(room.scan);
+  const mlmap::Scan written = mlmap::io::readXyz(labels);
+  REQUIRE(written.size() == input.size());
+  const mlmap::Point& p = input.points[1];
+  CHECK((written.points[1] - mlmap::Point(p.z(), p.y(), -p.x())).norm() < 1e-3);
+  CHECK(mlmap::test::contains(runCli("register --help").output, "--mount"));
+}

@@ -1,0 +1,99 @@
+// registration/up_axis.hpp: which way is up, from the planes a scan sees and the axis
+// its poses turn about; and the turn that makes it +z.
+#include <doctest/doctest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <numbers>
+
+#include "mlmap/registration/up_axis.hpp"
+
+using namespace mlmap;
+using registration::estimateUpAxis;
+using registration::UpCue;
+
+namespace {
+
+// A z-up room, x -2..4, y -3..1, floor 1 m below the sensor and ceiling 1.5 m above,
+// scanned from the origin by rays spread evenly over the sphere (a Fibonacci lattice):
+// near surfaces get denser readings, as a scanner's do.
+std::vector<Point> roomScan(int rays = 40000) {
+  const Eigen::Vector3d low(-2.0, -3.0, -1.0), high(4.0, 1.0, 1.5);
+  std::vector<Point> points;
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  for (int k = 0; k < rays; ++k) {
+    const double z = 1.0 - 2.0 * (k + 0.5) / rays;
+    const double radius = std::sqrt(1.0 - z * z);
+    const Eigen::Vector3d direction(radius * std::cos(golden * k), radius * std::sin(golden * k), z);
+    double nearest = 1e9;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (std::abs(direction[axis]) < 1e-12) continue;
+      const double bound = direction[axis] > 0 ? high[axis] : low[axis];
+      nearest = std::min(nearest, bound / direction[axis]);
+    }
+    points.push_back(nearest * direction);
+  }
+  return points;
+}
+
+Scan turned(const std::vector<Point>& points, const Eigen::Matrix3d& rotation) {
+  Scan scan;
+  for (const Point& point : points) scan.points.push_back(rotation * point);
+  return scan;
+}
+
+Eigen::Matrix3d about(const Eigen::Vector3d& axis, double degrees) {
+  return Eigen::AngleAxisd(degrees * std::numbers::pi / 180.0, axis).toRotationMatrix();
+}
+
+}  // namespace
+
+TEST_CASE("Up axis: a z-up room is z-up, the same room y-up or x-down is found so, and turned back") {
+  const std::vector<Point> room = roomScan();
+  const auto z_up = estimateUpAxis({turned(room, Eigen::Matrix3d::Identity())});
+  CHECK(z_up.line_from == UpCue::Planes);
+  CHECK(z_up.up.isApprox(Eigen::Vector3d::UnitZ()));
+  CHECK(z_up.below_share > 0.5);
+  // Turning the room's z onto +y (a camera's frame after its VIEWPOINT, PCL's office1).
+  const Eigen::Matrix3d to_y = about(Eigen::Vector3d::UnitX(), -90.0);
+  REQUIRE((to_y * Eigen::Vector3d::UnitZ()).isApprox(Eigen::Vector3d::UnitY()));
+  const auto y_up = estimateUpAxis({turned(room, to_y)});
+  CHECK(y_up.up.isApprox(Eigen::Vector3d::UnitY()));
+  CHECK(std::string(registration::axisName(y_up.up)) == "+y");
+  const auto x_down = estimateUpAxis({turned(room, about(Eigen::Vector3d::UnitY(), -90.0))});
+  CHECK(x_down.up.isApprox(-Eigen::Vector3d::UnitX()));
+  CHECK(std::string(registration::axisName(x_down.up)) == "-x");
+  for (const Eigen::Vector3d& up : {Eigen::Vector3d(Eigen::Vector3d::UnitX()), Eigen::Vector3d(-Eigen::Vector3d::UnitX()),
+                                    Eigen::Vector3d(Eigen::Vector3d::UnitY()), Eigen::Vector3d(-Eigen::Vector3d::UnitY()),
+                                    Eigen::Vector3d(Eigen::Vector3d::UnitZ()), Eigen::Vector3d(-Eigen::Vector3d::UnitZ())}) {
+    const Eigen::Matrix3d turn = registration::rotationToZUp(up);
+    CHECK((turn * up).isApprox(Eigen::Vector3d::UnitZ(), 1e-12));
+    CHECK(turn.determinant() == doctest::Approx(1.0));
+  }
+  // The y-up room turned back holds its floor level again: 1 m below the sensor.
+  const Scan back = turned(turned(room, to_y).points, registration::rotationToZUp(y_up.up));
+  std::size_t on_floor = 0;
+  for (const Point& point : back.points) on_floor += std::abs(point.z() + 1.0) < 1e-9 ? 1 : 0;
+  CHECK(on_floor > back.points.size() / 5);
+}
+
+TEST_CASE("Up axis: scans that turn about one axis give its line, whatever the planes say") {
+  // A corridor-like scene where one wall family outweighs the floor: the poses decide.
+  const std::vector<Point> room = roomScan(8000);
+  const Eigen::Matrix3d to_y = about(Eigen::Vector3d::UnitX(), -90.0);
+  std::vector<Scan> scans;
+  for (const double yaw : {0.0, 40.0, 95.0}) {
+    Scan scan = turned(room, Eigen::Matrix3d::Identity());
+    scan.pose = Pose(to_y * about(Eigen::Vector3d::UnitZ(), yaw));  // sensor z-up, world y-up
+    scans.push_back(scan);
+  }
+  const auto estimate = estimateUpAxis(scans);
+  CHECK(estimate.line_from == UpCue::Poses);
+  CHECK(estimate.up.isApprox(Eigen::Vector3d::UnitY()));
+  // No planes, no turn: no evidence, and up stays +z.
+  Scan sparse;
+  sparse.points = {Point(1, 0, 0), Point(0, 1, 0)};
+  const auto none = estimateUpAxis({sparse});
+  CHECK(none.line_from == UpCue::None);
+  CHECK(none.up.isApprox(Eigen::Vector3d::UnitZ()));
+}
