@@ -16,9 +16,9 @@ namespace {
 // Two cells, one at negative indices, with a floor, a wall and a labelled table.
 MLMap smallMap() {
   MLMap map(0.05);
-  const Block floor{0.01F, 1e-4F, 0.0F, 3, BlockKind::Horizontal};
-  const Block wall{2.4F, 2e-4F, 2.0F, 7, BlockKind::Vertical};
-  const Block table{0.75F, 1e-4F, 0.0F, 0, BlockKind::Horizontal};
+  const Block floor{0.01F, 1e-4F, 0.0F, 3, BlockKind::Horizontal, {}};
+  const Block wall{2.4F, 2e-4F, 2.0F, 7, BlockKind::Vertical, {}};
+  const Block table{0.75F, 1e-4F, 0.0F, 0, BlockKind::Horizontal, {}};
   const Block cells_a[] = {floor, wall};
   const Block cells_b[] = {floor, table};
   map.restoreCell({-4, 12}, cells_a);

@@ -216,21 +216,21 @@ TEST_CASE("MLMap: cell lookup agrees with a brute-force search") {
 TEST_CASE("MLMap insertBlock: a horizontal block fuses, a vertical one joins what it reaches") {
   MLMap map(kCell);
   const CellIndex cell{0, 0};
-  map.insertBlock(cell, Block{0.0F, 1e-4F, 0.0F, 0, BlockKind::Horizontal});
-  map.insertBlock(cell, Block{0.01F, 1e-4F, 0.0F, 0, BlockKind::Horizontal});
+  map.insertBlock(cell, Block{0.0F, 1e-4F, 0.0F, 0, BlockKind::Horizontal, {}});
+  map.insertBlock(cell, Block{0.01F, 1e-4F, 0.0F, 0, BlockKind::Horizontal, {}});
   REQUIRE(map.blocks(cell).size() == 1);
   CHECK(map.blocks(cell)[0].height == doctest::Approx(0.005));
-  map.insertBlock(cell, Block{1.0F, 1e-4F, 0.0F, 0, BlockKind::Horizontal});
-  map.insertBlock(cell, Block{2.0F, 1e-4F, 0.0F, 0, BlockKind::Horizontal});
+  map.insertBlock(cell, Block{1.0F, 1e-4F, 0.0F, 0, BlockKind::Horizontal, {}});
+  map.insertBlock(cell, Block{2.0F, 1e-4F, 0.0F, 0, BlockKind::Horizontal, {}});
   REQUIRE(map.blocks(cell).size() == 3);
   // A wall section from 0.5 to 1.95 reaches the blocks at 1.0 and 2.0, not the floor.
-  map.insertBlock(cell, Block{1.95F, 1e-4F, 1.45F, 0, BlockKind::Vertical});
+  map.insertBlock(cell, Block{1.95F, 1e-4F, 1.45F, 0, BlockKind::Vertical, {}});
   const auto blocks = map.blocks(cell);
   REQUIRE(blocks.size() == 2);
   CHECK(blocks[1].isVertical());
   CHECK(blocks[1].height == doctest::Approx(2.0));
   CHECK(blocks[1].bottom() == doctest::Approx(0.5));
-  CHECK_THROWS_AS(map.insertBlock(cell, Block{0.0F, 0.0F, 0.0F, 0, BlockKind::Horizontal}),
+  CHECK_THROWS_AS(map.insertBlock(cell, Block{0.0F, 0.0F, 0.0F, 0, BlockKind::Horizontal, {}}),
                   mlmap::Error);
 }
 
