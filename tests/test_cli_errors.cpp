@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "box_room_rays.hpp"
 #include "cli_runner.hpp"
 #include "helpers.hpp"
 #include "mlmap/io/xyz.hpp"
@@ -23,18 +24,10 @@ namespace {
 mlmap::Scan roomScan(bool with_junk, const Eigen::Vector3d& low = {-2.0, -3.0, -1.0},
                      const Eigen::Vector3d& high = {4.0, 1.0, 1.5}) {
   mlmap::Scan scan;
-  const int rays = 30000;
-  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
-  for (int k = 0; k < rays; ++k) {
-    const double z = 1.0 - 2.0 * (k + 0.5) / rays;
-    const double radius = std::sqrt(1.0 - z * z);
-    const Eigen::Vector3d direction(radius * std::cos(golden * k), radius * std::sin(golden * k), z);
-    double nearest = 1e9;
-    for (int axis = 0; axis < 3; ++axis) {
-      if (std::abs(direction[axis]) < 1e-12) continue;
-      nearest = std::min(nearest, (direction[axis] > 0 ? high[axis] : low[axis]) / direction[axis]);
-    }
-    scan.points.push_back(nearest * direction);
+  const auto rays = mlmap::test::boxRoomRays(30000, low, high);
+  for (std::size_t k = 0; k < rays.size(); ++k) {
+    const Eigen::Vector3d& direction = rays[k].direction;
+    scan.points.push_back(rays[k].range * direction);
     if (with_junk && k % 20 == 0) scan.points.push_back(0.15 * direction);
     if (with_junk && k % 20 == 10) scan.points.push_back(32.76 * direction);
   }

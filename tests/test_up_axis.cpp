@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "box_room_rays.hpp"
 #include "mlmap/registration/up_axis.hpp"
 
 using namespace mlmap;
@@ -18,20 +19,9 @@ namespace {
 // scanned from the origin by rays spread evenly over the sphere (a Fibonacci lattice):
 // near surfaces get denser readings, as a scanner's do.
 std::vector<Point> roomScan(int rays = 40000) {
-  const Eigen::Vector3d low(-2.0, -3.0, -1.0), high(4.0, 1.0, 1.5);
   std::vector<Point> points;
-  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
-  for (int k = 0; k < rays; ++k) {
-    const double z = 1.0 - 2.0 * (k + 0.5) / rays;
-    const double radius = std::sqrt(1.0 - z * z);
-    const Eigen::Vector3d direction(radius * std::cos(golden * k), radius * std::sin(golden * k), z);
-    double nearest = 1e9;
-    for (int axis = 0; axis < 3; ++axis) {
-      if (std::abs(direction[axis]) < 1e-12) continue;
-      const double bound = direction[axis] > 0 ? high[axis] : low[axis];
-      nearest = std::min(nearest, bound / direction[axis]);
-    }
-    points.push_back(nearest * direction);
+  for (const auto& ray : test::boxRoomRays(rays, {-2.0, -3.0, -1.0}, {4.0, 1.0, 1.5})) {
+    points.push_back(ray.range * ray.direction);
   }
   return points;
 }
