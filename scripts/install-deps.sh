@@ -4,7 +4,7 @@ set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PACKAGES=(build-essential cmake liboctomap-dev libeigen3-dev nlohmann-json3-dev doctest-dev
-          libcli11-dev liblzf-dev zlib1g-dev bzip2)
+          libcli11-dev liblzf-dev zlib1g-dev bzip2 ccache)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
