@@ -103,6 +103,14 @@ void addPlanesCommand(CLI::App& app, Context& context) {
   addNumber(command, "--min-patch-area", config.min_patch_area, "Smaller connected patches are dropped, m²", 0.0,
             Bound::Closed)
       ->capture_default_str();
+  addNumber(command, "--max-radius", config.max_radius,
+            "Widest direction window where r cells leave a level block's direction uncertain, cells (0: 2 r; r: never wider)",
+            0, Bound::Closed, 50.0)
+      ->capture_default_str();
+  addNumber(command, "--max-spread", config.max_direction_spread_deg,
+            "Mean angle of a plane's blocks' directions to its normal (level planes: beyond their noise), deg", 0.0,
+            Bound::Open, 90.0)
+      ->capture_default_str();
   addNumber(command, "--max-candidates", config.max_candidates, "Max_cp: candidates in all", 1, Bound::Closed)
       ->capture_default_str();
   addNumber(command, "--max-idle-candidates", config.max_idle_candidates,

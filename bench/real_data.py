@@ -122,7 +122,7 @@ def score(labels, owner, points, planes, annotation):
                       stray_patches=len(stray), stray_points=int(np.isin(labels, stray).sum()))
 
 
-def run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features):
+def run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features, planes_args=()):
     tag = os.path.join(folder, f"cell{cell:g}")
     # World-frame clouds (no sensor pose) are mapped as they are: --identity where the CLI
     # asks for it. The benchmark drops a scanner's own and no-return readings itself
@@ -132,7 +132,7 @@ def run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features
            (["--min-range", "0"] if "--min-range" in features["build"] else [])
     build = [mlmap, "-q", "build", "-o", tag + ".mlmap", "--cell-size", str(cell), "--no-octree"] + posed + up_options + wide
     _, build_s = run(build + files)
-    run([mlmap, "-q", "planes", tag + ".mlmap", "--threads", "2", "-o", tag + ".planes.mlmap", "--json", tag + ".planes.json"])
+    run([mlmap, "-q", "planes", tag + ".mlmap", "--threads", "2", "-o", tag + ".planes.mlmap", "--json", tag + ".planes.json"] + list(planes_args))
     planes_json = json.load(open(tag + ".planes.json"))
     label = [mlmap, "-q", "label", tag + ".planes.mlmap", "-o", tag + ".labels.xyz"] + posed
     if "--up" in features["label"]:
@@ -243,6 +243,7 @@ def main():
     ap.add_argument("--cells", default="0.05,0.1")
     ap.add_argument("--peers", help="build directory of ../shared/peers (cgal_ransac); optional")
     ap.add_argument("--only", help="comma-separated scene names")
+    ap.add_argument("--planes-args", default="", help="extra arguments for `mlmap planes`, e.g. \"--noise 0.01\"")
     ap.add_argument("--docs", help="write one picture per scene here (docs/real-NAME.png)")
     a = ap.parse_args()
     if not os.path.isdir(a.data):
@@ -278,7 +279,8 @@ def main():
             pose_file = registered
         results, labelled = {}, {}
         for cell in cells:
-            points, labels, planes, times = run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features)
+            points, labels, planes, times = run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features,
+                                                      a.planes_args.split())
             if len(labels) != len(world):
                 raise SystemExit(f"real_data: {name}: mlmap label wrote {len(labels)} points for {len(world)} input points")
             rows, extra = score(labels, owner, points, planes, annotation)

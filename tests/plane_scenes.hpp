@@ -23,7 +23,7 @@ class PlaneSceneBuilder {
       for (int b = 0; b <= steps_v; ++b) {
         const Eigen::Vector3d p = corner + u * (static_cast<double>(a) / steps_u) +
                                   v * (static_cast<double>(b) / steps_v) + normal * noise_(random_);
-        map_.insert(p, 1e-4);
+        map_.insert(p, variance_);
       }
     }
     return *this;
@@ -39,10 +39,19 @@ class PlaneSceneBuilder {
     return rectangle({x0, y, z0}, {x1 - x0, 0, 0}, {0, 0, z1 - z0});
   }
 
+  // The rectangles after this: points `noise` m off their plane (standard deviation),
+  // inserted as measurements of variance `variance` m².
+  PlaneSceneBuilder& withNoise(double noise, double variance = 1e-4) {
+    noise_ = std::normal_distribution<double>(0.0, noise);
+    variance_ = variance;
+    return *this;
+  }
+
   MLMap& map() { return map_; }
 
  private:
   MLMap map_;
+  double variance_ = 1e-4;
   std::normal_distribution<double> noise_;
   std::mt19937 random_;
 };

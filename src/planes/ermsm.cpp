@@ -82,11 +82,12 @@ bool hasPointStats(const MLMap& map) {
 
 class Detector {
  public:
-  Detector(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions, const ErmsmConfig& config)
+  Detector(const BlockGrid& grid, const DirectionField& field, const ErmsmConfig& config)
       : grid_(grid),
-        directions_(directions),
+        directions_(field.vectors),
+        tilts_(field.tilts),
         config_(config),
-        scorer_(grid, directions, config.epsilon, radians(config.kappa_deg), config.threads),
+        scorer_(grid, field.vectors, config.epsilon, radians(config.kappa_deg), config.threads),
         min_score_(config.min_area / (grid.cellSize() * grid.cellSize())),
         patch_threads_(teamSize(patchPassThreads(grid, config.threads))) {
     patches_.labels.assign(grid.size(), 0);
@@ -94,7 +95,7 @@ class Detector {
     const auto blocks = static_cast<std::int64_t>(grid.size());
 #pragma omp parallel for schedule(static) num_threads(patch_threads_) if (patch_threads_ > 1)
     for (std::int64_t id = 0; id < blocks; ++id) {
-      directed[static_cast<std::size_t>(id)] = directions[static_cast<std::size_t>(id)].squaredNorm() > 0.0F ? 1 : 0;
+      directed[static_cast<std::size_t>(id)] = field.vectors[static_cast<std::size_t>(id)].squaredNorm() > 0.0F ? 1 : 0;
     }
     seedable_ = grid.idsInMapOrder(directed, patch_threads_);
   }
@@ -110,11 +111,14 @@ class Detector {
   }
   std::optional<std::size_t> bestCandidate();
   double acceptanceProbability(const Candidate& leader) const;
+  bool noiseExplainsSpread(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const;
+  bool liesOnPlane(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const;
   bool accept(std::size_t index);
   void drop(std::size_t index);
 
   const BlockGrid& grid_;
   const std::vector<Eigen::Vector3f>& directions_;
+  const std::vector<float>& tilts_;
   const ErmsmConfig& config_;
   PlaneScorer scorer_;
   double min_score_;
@@ -189,6 +193,29 @@ double Detector::acceptanceProbability(const Candidate& leader) const {
   return 1.0 - std::pow(1.0 - std::pow(ratio, config_.acceptance_exponent), static_cast<double>(listed));
 }
 
+// A level plane whose blocks' directions spread more than max_direction_spread_deg may
+// still be a surface: its blocks scatter in height by the range noise, and where that is
+// a good part of a cell (3DTK's ceiling at 5 cm cells: 5.5 cm RMS) their directions
+// spread by more than 8° without any curvature. Accepted when the spread is within the
+// limit on top of that noise (the two adding in squares). Not for walls: a vertical
+// block's direction is uncertain where its window holds a corner or a pillar's turn,
+// which is what the spread rule is for (excusing that let 45° facets across the lab's
+// corners through).
+bool Detector::noiseExplainsSpread(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const {
+  const double limit = spreadLimit(config_.max_direction_spread_deg, noiseSpread(tilts_, strict, radians(config_.kappa_deg)));
+  return !spreadExceeds(grid_, directions_, strict, plane, limit, patch_threads_);
+}
+
+// A level plane's blocks must lie on it: the median distance of their points' means
+// from it at most ε / 3. Noise of σ ≤ ε / 3 puts it at 0.67 σ or less; a heap of clutter
+// filling the slab ±ε round the plane at ε / 2. Direction windows widened over a heap see
+// it level on average, so the spread rule alone no longer refuses one. A median, so that
+// blocks a chair or a lamp pulls off a table or ceiling do not count. Level planes only:
+// a vertical block sits at mid-height, its distance from a tilted plane says nothing.
+bool Detector::liesOnPlane(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const {
+  return medianDistance(grid_, strict, plane) <= config_.epsilon / 3.0;
+}
+
 void Detector::drop(std::size_t index) {
   unlisted_ += static_cast<std::size_t>(candidates_[index].multiplicity);
   candidates_.erase(candidates_.begin() + static_cast<long>(index));
@@ -209,7 +236,10 @@ bool Detector::accept(std::size_t index) {
   }
   const double kappa = radians(config_.kappa_deg);
   const std::vector<std::uint32_t> strict = scorer_.matching(accepted.plane);
-  if (spreadExceeds(grid_, directions_, strict, accepted.plane, config_.max_direction_spread_deg, patch_threads_)) {
+  const bool level = std::abs(accepted.plane.normal.z()) >= std::cos(radians(45.0));
+  if ((level && !liesOnPlane(accepted.plane, strict)) ||
+      (spreadExceeds(grid_, directions_, strict, accepted.plane, config_.max_direction_spread_deg, patch_threads_) &&
+       !(level && noiseExplainsSpread(accepted.plane, strict)))) {
     refused_.push_back(accepted.plane);
     drop(index);
     return false;
@@ -225,7 +255,6 @@ bool Detector::accept(std::size_t index) {
   // A join (a wall's pieces) leaves fewer patches: theirs are rasterised again for
   // their outlines.
   if (split.patches.size() != pieces) split.outline_runs.assign(split.patches.size(), {});
-  const bool level = std::abs(accepted.plane.normal.z()) >= std::cos(radians(45.0));
   const double min_width =
       (level ? config_.min_level_patch_width_cells : config_.min_patch_width_cells) * grid_.cellSize();
   std::vector<std::uint32_t> taken;
@@ -401,14 +430,18 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   stats.stages.grid = stage();
   DirectionConfig direction_config;
   direction_config.radius = config.radius;
+  // Two directions off their plane's normal by s per axis differ by more than θ in one
+  // pair of twenty when s = θ / (2.45 √2) (the difference's length is Rayleigh, 95 % below 2.45 √2 s).
+  direction_config.max_radius = config.max_radius > 0 ? config.max_radius : 2 * config.radius;
+  direction_config.max_tilt = radians(config.theta_deg) / (2.45 * std::sqrt(2.0));
   direction_config.height_tolerance = static_cast<float>(config.epsilon);
   direction_config.threads = config.threads;
-  const std::vector<Eigen::Vector3f> directions = directionVectors(grid, direction_config);
+  const DirectionField directions = directionField(grid, direction_config);
   stats.stages.directions = stage();
   stats.direction_seconds = secondsSince(start);
   stats.blocks = grid.size();
   stats.blocks_with_direction = static_cast<std::size_t>(
-      std::count_if(directions.begin(), directions.end(), [](const Eigen::Vector3f& d) { return d.squaredNorm() > 0.0F; }));
+      std::count_if(directions.vectors.begin(), directions.vectors.end(), [](const Eigen::Vector3f& d) { return d.squaredNorm() > 0.0F; }));
 
   const auto detection_start = Clock::now();
   Detector detector(grid, directions, config);

@@ -85,6 +85,28 @@ double directionSpread(const BlockGrid& grid, const std::vector<Eigen::Vector3f>
   return weight > 0.0 ? weighted / weight * 180.0 / std::numbers::pi : 0.0;
 }
 
+double medianDistance(const BlockGrid& grid, const std::vector<std::uint32_t>& ids, const CandidatePlane& plane) {
+  if (ids.empty()) return 0.0;
+  std::vector<float> distances;
+  distances.reserve(ids.size());
+  for (const std::uint32_t id : ids) distances.push_back(std::abs(plane.normal.dot(grid.blocks()[id].point - plane.point)));
+  auto middle = distances.begin() + static_cast<long>(distances.size() / 2);
+  std::nth_element(distances.begin(), middle, distances.end());
+  return *middle;
+}
+
+double noiseSpread(const std::vector<float>& tilts, const std::vector<std::uint32_t>& ids, double kappa_rad) {
+  std::vector<float> known;
+  known.reserve(ids.size());
+  for (const std::uint32_t id : ids) {
+    if (std::isfinite(tilts[id])) known.push_back(std::min(tilts[id], static_cast<float>(kappa_rad)));
+  }
+  if (known.empty()) return 0.0;
+  auto middle = known.begin() + static_cast<long>(known.size() / 2);
+  std::nth_element(known.begin(), middle, known.end());
+  return *middle * std::sqrt(std::numbers::pi / 2.0) * 180.0 / std::numbers::pi;
+}
+
 bool spreadExceeds(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                    const std::vector<std::uint32_t>& ids, const CandidatePlane& plane, double max_deg, int threads) {
   // An angle θ = acos c of [0, π/2] lies between sin θ and tan θ: with s = √(1 − c²),

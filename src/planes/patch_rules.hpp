@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <cmath>
 #include <vector>
 
 #include "mlmap/planes/block_grid.hpp"
@@ -33,6 +34,20 @@ double directionSpread(const BlockGrid& grid, const std::vector<Eigen::Vector3f>
 bool spreadExceeds(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                    const std::vector<std::uint32_t>& ids, const CandidatePlane& plane, double max_deg,
                    int threads = 1);
+
+// Noise alone spreads directions: a block's direction off by a standard error s per
+// axis lies a mean s √(π/2) from the normal (a Rayleigh length). That for the median s
+// of the blocks `ids`, in degrees (each at most κ; blocks whose window was too small to
+// tell left out): the median, so that a small patch's edge blocks, whose windows reach
+// over its border, do not excuse its spread.
+double noiseSpread(const std::vector<float>& tilts, const std::vector<std::uint32_t>& ids, double kappa_rad);
+// The spread a plane may show: a curved surface's own spread of max_deg on top of the
+// noise's, the two adding as independent errors do (in squares).
+inline double spreadLimit(double max_deg, double noise_deg) { return std::hypot(max_deg, noise_deg); }
+
+// The median distance of the blocks `ids` (their points' mean) from the plane, m: how
+// thick they lie round it, robust to the few a neighbouring object pulls away.
+double medianDistance(const BlockGrid& grid, const std::vector<std::uint32_t>& ids, const CandidatePlane& plane);
 
 // A patch one cell wide is no surface: it is the fringe of a wall standing on a cell
 // boundary (stray points in the next column) or a line of clutter. True when its blocks

@@ -19,8 +19,9 @@
 namespace mlmap {
 
 struct SmallestAxis {
-  Eigen::Vector3d axis;     // unit, sign arbitrary
-  double middle_eigenvalue; // the second smallest
+  Eigen::Vector3d axis;       // unit, sign arbitrary
+  double middle_eigenvalue;   // the second smallest
+  double smallest_eigenvalue; // the variance along the axis
 };
 
 inline SmallestAxis smallestAxis(const Eigen::Matrix3d& covariance) {
@@ -60,12 +61,12 @@ inline SmallestAxis smallestAxis(const Eigen::Matrix3d& covariance) {
         if (candidates[k].squaredNorm() > candidates[longest].squaredNorm()) longest = k;
       }
       const double length = candidates[longest].norm();
-      if (length > 0.0) return {candidates[longest] / length, middle};
+      if (length > 0.0) return {candidates[longest] / length, middle, std::max(0.0, lambda)};
     }
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(covariance);
-  return {solver.eigenvectors().col(0), solver.eigenvalues()(1)};
+  return {solver.eigenvectors().col(0), solver.eigenvalues()(1), std::max(0.0, solver.eigenvalues()(0))};
 }
 
 }  // namespace mlmap

@@ -15,15 +15,33 @@
 
 namespace mlmap {
 
+// Where the blocks scatter across their surface by a good part of the window, r cells
+// leave a direction too uncertain for the seeds' agreement test: on 3DTK's corridor
+// ceiling at 5 cm cells (blocks 5.5 cm RMS about its plane, 1-2 points each) the
+// directions of r = 2 lie a median 11 deg off its normal, and the ceiling was no patch.
+// Such a block's window widens, a cell at a time up to max_radius, until the normal's
+// standard error, from the window's own residual and spread, is at most max_tilt.
 struct DirectionConfig {
   int radius = 2;                 // cells, Chebyshev radius r of the neighbourhood
   float height_tolerance = 0.08F; // m, horizontal neighbours must lie this close in height
+  int max_radius = 0;             // cells, the widest window; <= radius: never wider
+  double max_tilt = 0.0;          // rad, per axis; 0: never wider
   int threads = 0;                // OpenMP threads; 0 = OpenMP's default
 };
 
-// Unit vectors, indexed by block id, oriented consistently (horizontal: n_z ≥ 0;
-// vertical: the larger of |n_x|, |n_y| positive). Zero where the neighbourhood is too
-// small or too thin to define a surface.
+struct DirectionField {
+  // Unit vectors, indexed by block id, oriented consistently (horizontal: n_z ≥ 0;
+  // vertical: the larger of |n_x|, |n_y| positive). Zero where the neighbourhood is too
+  // small or too thin to define a surface.
+  std::vector<Eigen::Vector3f> vectors;
+  // rad, per block: the standard error of its direction per axis, from its window's
+  // residual and spread (infinite where the window holds too few blocks to tell).
+  std::vector<float> tilts;
+};
+
+DirectionField directionField(const BlockGrid& grid, const DirectionConfig& config);
+
+// The vectors alone.
 std::vector<Eigen::Vector3f> directionVectors(const BlockGrid& grid, const DirectionConfig& config);
 
 // The same orientation rule, for any normal.

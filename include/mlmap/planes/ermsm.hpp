@@ -14,6 +14,9 @@ namespace mlmap {
 
 struct ErmsmConfig {
   int radius = 2;                 // cells, Chebyshev radius r (direction vectors, candidate seeds)
+  // cells: a level block's direction window widens up to this where r cells leave its
+  // normal uncertain (standard error over θ / 3.5: noisy or sparse surfaces); 0 = 2 r
+  int max_radius = 0;
   double epsilon = 0.0;           // m, max block-plane distance ε; 0 = max(cell size, min(3 σ, 0.05))
   double noise = 0.0;             // m, σ of the points' range noise; 0 = the median of the map's vertical blocks' σ
   // m: consecutive blocks of a cell closer than this are one eRMSM block (a wall's stack
@@ -41,7 +44,11 @@ struct ErmsmConfig {
   // stair tread or a bench top against a wall is two cells deep at 10 cm cells; the
   // slivers the width rule is for are walls in room corners, where directions turn.
   double min_level_patch_width_cells = 0.45;
-  double max_direction_spread_deg = 8.0;   // deg, mean angle of a plane's blocks to its normal (curved surfaces fail)
+  // deg, mean angle of a plane's blocks to its normal (curved surfaces fail); for level
+  // planes beyond what the noise of their blocks' directions gives (the two add in
+  // squares): where a surface's points scatter by a good part of a cell (3DTK's ceiling at
+  // 5 cm) noise alone spreads its directions by more than 8°.
+  double max_direction_spread_deg = 8.0;
   int max_candidates = 4000;      // Max_cp: Algorithm 1 stops after this many candidates
   int max_idle_candidates = 300;  // ... or after this many without an accepted plane
   int batch_size = 16;            // candidates per iteration of Algorithm 1 (fixed, not per thread)
