@@ -18,6 +18,8 @@ export async function launchChromium() {
   const context = await chromium.launchPersistentContext(userDataDir, {
     executablePath: CHROMIUM, headless: true, args, viewport: { width: 1440, height: 900 },
   });
+  // Software WebGL on a shared, loaded machine: loading a page can take well over the 30 s default.
+  context.setDefaultTimeout(120_000);
   return { context, userDataDir };
 }
 
