@@ -253,12 +253,16 @@ declare global {
 window.mlmapDashboard = {
   state: () => ({
     state: document.body.dataset.state, patches: data?.planes.length ?? 0, blocks: blocks?.count ?? 0, voxels: voxels?.count ?? 0, selected,
-    highlighted: view?.highlightedId() ?? null, webgl: view !== null, cut: cut.range(), measure: measure.state(),
+    highlighted: view?.highlightedId() ?? null, webgl: view !== null, software: view?.software ?? null, cut: cut.range(), measure: measure.state(),
   }),
   pickAt: (x: number, y: number) => view?.pickAt(x, y) ?? null,
   probe: (x: number, y: number) => view?.probe(x, y) ?? null,
   project: (point: [number, number, number]) => view?.project(point) ?? null,
   camera: () => view?.cameraState() ?? null,
+  /** Resolves once the 3D view shows the page's state with every block drawn. */
+  drawn: () => view?.whenDrawn() ?? Promise.resolve(),
+  drawing: () => view?.drawing() ?? null,
+  setFrameBudget: (boxes: number | null) => view?.setFrameBudget(boxes),
 };
 
 async function start(): Promise<void> {

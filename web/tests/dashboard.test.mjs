@@ -108,6 +108,7 @@ test('a click on a row highlights its patch in 3D', async () => {
   assert.equal(await page.getAttribute('#view', 'data-highlighted-id'), String(id));
   assert.equal((await state(page)).highlighted, id);
   assert.ok((await page.textContent('#pick-info')).startsWith(`#${id} `));
+  await page.evaluate(() => window.mlmapDashboard.drawn());
   await page.screenshot({ path: path.join(output, 'dashboard-selected.png') });
   await row.click(); // a second click lets go
   assert.equal((await state(page)).highlighted, null);
@@ -209,6 +210,7 @@ test('opened from disk (file://) with planes.js beside it, and without', async (
     await expectLab(page);
     assert.equal((await state(page)).webgl, true);
     await page.waitForTimeout(300);
+    await page.evaluate(() => window.mlmapDashboard.drawn());
     await page.screenshot({ path: path.join(output, 'dashboard.png') });
     await page.close();
   } finally {
