@@ -23,6 +23,11 @@ export async function launchChromium() {
   return { context, userDataDir };
 }
 
+/** Waits (within the context's timeout) until the 3D view shows the page's state with every box drawn. */
+export function waitDrawn(page) {
+  return page.waitForFunction(() => window.mlmapDashboard?.drawing()?.complete ?? true);
+}
+
 const TYPES = { '.html': 'text/html; charset=utf-8', '.js': 'text/javascript; charset=utf-8', '.json': 'application/json', '.png': 'image/png' };
 
 /** Serves the files under root on 127.0.0.1 at a random port; returns { url, close }. */

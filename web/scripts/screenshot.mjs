@@ -10,7 +10,7 @@ import { existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
-import { launchChromium, planesJs } from './browser.mjs';
+import { launchChromium, planesJs, waitDrawn } from './browser.mjs';
 
 const [input, out, size = '1600x1000', colourMode = 'class', view = 'reset'] = process.argv.slice(2);
 if (!input || !out || !['reset', 'top', 'side'].includes(view)) {
@@ -46,7 +46,7 @@ try {
   }
   await page.selectOption('#colour-mode', colourMode);
   if (view !== 'reset') await page.click(`#view-${view}`);
-  await page.evaluate(() => window.mlmapDashboard.drawn());
+  await waitDrawn(page);
   await mkdir(path.dirname(path.resolve(out)), { recursive: true });
   await page.screenshot({ path: out });
   console.log(`wrote ${out}`);

@@ -10,7 +10,7 @@ import { existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
-import { launchChromium, serveDir } from '../scripts/browser.mjs';
+import { launchChromium, serveDir, waitDrawn } from '../scripts/browser.mjs';
 
 const web = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const output = path.join(web, 'test-output');
@@ -110,9 +110,9 @@ const probeGrid = (page, n) => page.evaluate((n) => {
 }, n);
 
 /** Pixels of the 3D view near an RGB colour (or, for rgb 'yellow', lit yellow ones), as a fraction. */
-function colourFraction(page, rgb, tolerance = 40) {
+async function colourFraction(page, rgb, tolerance = 40) {
+  await waitDrawn(page); // the picture is drawn over frames: wait for all of it
   return page.evaluate(async ([rgb, tolerance]) => {
-    await window.mlmapDashboard.drawn(); // the picture is drawn over frames: wait for all of it
     const canvas = document.querySelector('#stage canvas');
     const image = new Image();
     image.src = canvas.toDataURL('image/png');
@@ -135,15 +135,15 @@ const BACKGROUND = [0x1b, 0x20, 0x2a];
 
 /** A screenshot of the page once the 3D view has drawn every box, into test-output/. */
 async function shot(page, name) {
-  await page.evaluate(() => window.mlmapDashboard.drawn());
+  await waitDrawn(page);
   await page.screenshot({ path: path.join(output, name) });
 }
 
 /** The 3D view's picture once every box is drawn, as a data URL. */
-const picture = (page) => page.evaluate(async () => {
-  await window.mlmapDashboard.drawn();
-  return document.querySelector('#stage canvas').toDataURL();
-});
+async function picture(page) {
+  await waitDrawn(page);
+  return page.evaluate(() => document.querySelector('#stage canvas').toDataURL());
+}
 
 for (const width of WIDTHS) {
   test(`${width} px: the export opened from disk shows every block, under the map's own name`, async () => {
@@ -315,8 +315,8 @@ for (const width of WIDTHS) {
       const uncut = await probeGrid(page, 20);
       assert.ok(uncut.filter((h) => ceilingIds.has(h.id)).length > 0.5 * uncut.length, 'from above, most probes hit the ceiling\'s blocks');
       // The ceiling as drawn from above: the colour at the middle of the view.
+      await waitDrawn(page);
       const ceilingRgb = await page.evaluate(async () => {
-        await window.mlmapDashboard.drawn();
         const canvas = document.querySelector('#stage canvas');
         const image = new Image();
         image.src = canvas.toDataURL('image/png');
