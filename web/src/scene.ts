@@ -8,32 +8,12 @@ import type { Patch, PlaneClass, PlanesExport, Vec3 } from './planes';
 import { patchColour, type ColourMode } from './colours';
 import type { BlockSet, VoxelSet } from './blocks';
 import { BoxLayer, blockBoxes, voxelBoxes } from './block_layer';
+import { BOX_LAYER, OVERLAY_LAYER, Pictures, softwareWebGL } from './pictures';
 
 const HIGHLIGHT = new THREE.Color('#ffe14d');
 const BACKGROUND = new THREE.Color('#1b202a');
 // m, a cut's plane this far away cuts nothing
 const NO_CUT = 1e6;
-// A frame of about this many ms keeps dragging smooth (20 frames a second).
-const FRAME_MS = 50;
-// boxes a frame: the first guess (a 2-core CPU drawing WebGL manages ~20k in 50 ms idle) and
-// the limits of the budget (a GPU draws 2M boxes in well under a frame)
-const BUDGET_START = 20_000;
-const BUDGET_MIN = 2_000;
-const BUDGET_MAX = 2_000_000;
-// three.js layers: the boxes, drawn over several frames; the patches and measure markers,
-// drawn once all boxes are; everything else (grid, bounds, axes) stays on layer 0.
-const BOX_LAYER = 1;
-const OVERLAY_LAYER = 2;
-
-/** Whether WebGL is drawn by the CPU: the renderer's name, as the browser tells it. */
-function softwareWebGL(): boolean {
-  const gl = document.createElement('canvas').getContext('webgl2');
-  if (!gl) return false;
-  const info = gl.getExtension('WEBGL_debug_renderer_info');
-  const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
-  gl.getExtension('WEBGL_lose_context')?.loseContext();
-  return /swiftshader|llvmpipe|softpipe|software|lavapipe|basic render/i.test(name);
-}
 
 /** What a click or a probe found: a patch's id (null for an unlabelled block) and the point hit. */
 export interface Hit {
@@ -96,19 +76,8 @@ export class PlanesView {
   private readonly markers = new THREE.Group();
   /** WebGL drawn by the CPU (SwiftShader, llvmpipe): no antialiasing, one pixel a CSS pixel. */
   readonly software: boolean;
-  // Pictures are drawn on demand (a change asks for one), never in a loop. A picture of many
-  // boxes is drawn over several frames, a budget of boxes each, in the boxes' shuffled order:
-  // the first frame shows an even sample of the map, the next ones fill it in, and a change
-  // (a drag, a slider) starts a new picture at once instead of waiting for the last one.
-  private frameRequested = false;
-  private progress = 0; // the share of the boxes drawn into the picture so far
-  private drawnWhole = true; // the picture is complete (nothing asked yet: nothing to draw)
-  private waiting: (() => void)[] = [];
-  private budget = BUDGET_START; // boxes a frame, sized so that a frame takes about FRAME_MS
-  private fixedBudget = false; // set by setFrameBudget (tests): no adapting
-  private lastFrame = 0;
-  private lastFrameBoxes = 0;
-  private frames = 0; // frames the picture took so far
+  // Pictures drawn on demand, a big one over several frames (pictures.ts).
+  private readonly pictures: Pictures;
 
   /** Throws if WebGL cannot start. onClick gets what a click hit, or null for empty space. */
   constructor(private readonly container: HTMLElement, private readonly onClick: (hit: Hit | null) => void) {
@@ -121,6 +90,8 @@ export class PlanesView {
     // The clear colour, not scene.background: three.js clears for a background colour at every
     // render, and a picture drawn over several frames must not be cleared between them.
     this.renderer.setClearColor(BACKGROUND, 1);
+    this.pictures = new Pictures(this.renderer, this.scene, this.camera,
+      () => this.boxLayers.filter(({ what }) => this.layerShown(what)).map(({ layer }) => layer));
     this.camera.up.set(0, 0, 1);
     const sky = new THREE.HemisphereLight('#ffffff', '#445066', 1.6);
     const sun = new THREE.DirectionalLight('#ffffff', 1.4);
@@ -307,81 +278,24 @@ export class PlanesView {
     return { position: this.camera.position.toArray() as Vec3, target: this.controls.target.toArray() as Vec3 };
   }
 
-  /** Asks for a new picture: started at the next animation frame, once for any number of asks. */
+  /** Asks for a new picture, drawn from the next animation frame on (pictures.ts). */
   render(): void {
-    this.progress = 0;
-    this.drawnWhole = false;
-    this.requestFrame();
+    this.pictures.request();
   }
 
   /** Resolves once the picture shows the current state with every box drawn (for tests and the PNG). */
   whenDrawn(): Promise<void> {
-    if (this.drawnWhole) return Promise.resolve();
-    return new Promise((resolve) => this.waiting.push(resolve));
+    return this.pictures.whenDrawn();
   }
 
   /** Boxes a frame: a fixed number, or null to size it from the frame times again (for tests). */
   setFrameBudget(boxes: number | null): void {
-    this.fixedBudget = boxes !== null;
-    this.budget = boxes ?? BUDGET_START;
-    this.render();
+    this.pictures.setBudget(boxes);
   }
 
   /** How the picture is drawn: the frames it took (so far), the boxes a frame and whether it is complete. */
   drawing(): { frames: number; budget: number; complete: boolean } {
-    return { frames: this.frames, budget: this.budget, complete: this.drawnWhole };
-  }
-
-  private requestFrame(): void {
-    if (this.frameRequested) return;
-    this.frameRequested = true;
-    requestAnimationFrame(() => {
-      this.frameRequested = false;
-      this.drawFrame();
-    });
-  }
-
-  /** One frame of the picture: the boxes' next share, then, once all are drawn, what lies over them. */
-  private drawFrame(): void {
-    const now = performance.now();
-    // Aim at FRAME_MS a frame: the time since the last frame tells what its share cost.
-    const interval = now - this.lastFrame;
-    if (!this.fixedBudget && this.lastFrameBoxes > 0 && interval < 1000) {
-      const scale = Math.min(1.5, Math.max(0.5, FRAME_MS / interval));
-      // Only a frame that drew its whole budget says the budget is too small.
-      if (scale < 1 || this.lastFrameBoxes >= this.budget) this.budget = Math.min(BUDGET_MAX, Math.max(BUDGET_MIN, this.budget * scale));
-    }
-    const layers = this.boxLayers.filter(({ what, layer }) => this.layerShown(what) && layer.count > 0).map(({ layer }) => layer);
-    const total = layers.reduce((sum, layer) => sum + layer.count, 0);
-    const from = this.progress;
-    const to = total === 0 ? 1 : Math.min(1, from + this.budget / total);
-    for (const layer of layers) layer.setRange(Math.floor(from * layer.chunks), to >= 1 ? layer.chunks : Math.floor(to * layer.chunks));
-    const r = this.renderer;
-    r.autoClear = from === 0; // a new picture starts on the background
-    this.frames = from === 0 ? 1 : this.frames + 1;
-    // The first frame: the helpers (grid, bounds, axes) and the boxes' first share; later ones
-    // the boxes only, over the picture so far (its depth kept: preserveDrawingBuffer).
-    this.camera.layers.set(BOX_LAYER);
-    if (from === 0) this.camera.layers.enable(0);
-    r.render(this.scene, this.camera);
-    if (to >= 1) {
-      // Patches (some see-through) and markers (drawn over everything) go on top of all boxes.
-      this.camera.layers.set(OVERLAY_LAYER);
-      r.autoClear = false;
-      r.render(this.scene, this.camera);
-    }
-    this.camera.layers.enableAll();
-    this.lastFrame = now;
-    this.lastFrameBoxes = (to - from) * total;
-    this.progress = to;
-    if (to < 1) {
-      this.requestFrame();
-      return;
-    }
-    this.drawnWhole = true;
-    const waiting = this.waiting;
-    this.waiting = [];
-    for (const resolve of waiting) resolve();
+    return this.pictures.state();
   }
 
   private clear(): void {
