@@ -353,11 +353,11 @@ for (const width of WIDTHS) {
       const hits = await probeGrid(page, 40);
       for (const hit of hits) assert.ok(hit.point[2] >= 0.5 - 1e-4 && hit.point[2] <= 1.0 + 1e-4, `hit at z ${hit.point[2]} outside the slice`);
       assert.ok(hits.length >= 10, `the slice holds something (${hits.length} hits)`);
+      await shot(page, `viewer-slice-${width}.png`);
       // Without the cut, the same probes hit the ceiling and the floor too.
       await page.click('#cut-clear');
       const all = await probeGrid(page, 40);
       assert.ok(all.some((h) => h.point[2] > 1.0 + 1e-4) && all.length > hits.length);
-      await shot(page, `viewer-slice-${width}.png`);
       assert.deepEqual((await state(page)).cut, { bottom: null, top: null });
       assert.deepEqual(pageErrors, []);
     });
