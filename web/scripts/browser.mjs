@@ -18,7 +18,14 @@ export async function launchChromium() {
   const context = await chromium.launchPersistentContext(userDataDir, {
     executablePath: CHROMIUM, headless: true, args, viewport: { width: 1440, height: 900 },
   });
+  // Software WebGL on a shared, loaded machine: loading a page can take well over the 30 s default.
+  context.setDefaultTimeout(120_000);
   return { context, userDataDir };
+}
+
+/** Waits (within the context's timeout) until the 3D view shows the page's state with every box drawn. */
+export function waitDrawn(page) {
+  return page.waitForFunction(() => window.mlmapDashboard?.drawing()?.complete ?? true);
 }
 
 const TYPES = { '.html': 'text/html; charset=utf-8', '.js': 'text/javascript; charset=utf-8', '.json': 'application/json', '.png': 'image/png' };

@@ -2,7 +2,10 @@
 
 import type { Patch, PlaneClass } from './planes';
 
-export type ColourMode = 'class' | 'id';
+export type ColourMode = 'class' | 'id' | 'height';
+
+/** Blocks on no plane, in the class and id modes. */
+export const UNLABELLED_COLOUR = '#6f7683';
 
 export const CLASS_COLOURS: Record<PlaneClass, string> = {
   floor: '#4f8fd8',
@@ -40,6 +43,28 @@ export function idColour(id: number): string {
   return `rgb(${byte(r)}, ${byte(g)}, ${byte(b)})`;
 }
 
+/** The z range the height colours span; set by the page from the map's bounds. */
+export const heightRange = { min: 0, max: 3 };
+
+// Blue (low) through cyan, green and yellow to red (high): neighbouring storeys differ in hue.
+const RAMP: [number, number, number][] = [[0.19, 0.33, 0.85], [0.16, 0.72, 0.85], [0.3, 0.78, 0.36], [0.96, 0.84, 0.25], [0.9, 0.3, 0.22]];
+
+/** The height colour of z as r, g, b in 0..1. */
+export function heightRgb(z: number, out: [number, number, number] = [0, 0, 0]): [number, number, number] {
+  const span = heightRange.max - heightRange.min;
+  const t = Math.min(1, Math.max(0, span > 0 ? (z - heightRange.min) / span : 0.5)) * (RAMP.length - 1);
+  const k = Math.min(RAMP.length - 2, Math.floor(t));
+  const f = t - k;
+  for (let c = 0; c < 3; c++) out[c] = RAMP[k][c] + (RAMP[k + 1][c] - RAMP[k][c]) * f;
+  return out;
+}
+
+export function heightColour(z: number): string {
+  const [r, g, b] = heightRgb(z).map((c) => Math.round(c * 255));
+  return `rgb(${r}, ${g}, ${b})`;
+}
+
 export function patchColour(patch: Patch, mode: ColourMode): string {
+  if (mode === 'height') return heightColour(patch.centroid[2]);
   return mode === 'class' ? CLASS_COLOURS[patch.label] : idColour(patch.id);
 }

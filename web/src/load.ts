@@ -1,17 +1,26 @@
 // Where a planes export comes from: ?src=URL, window.MLMAP_PLANES (set by planes.js beside the
 // page, as `mlmap export --dashboard DIR` writes it), a file picker or a file dropped on the page.
+// The blocks likewise: ?blocks=URL, window.MLMAP_BLOCKS (blocks.js, base64) or a picked blocks.bin;
+// and the voxels: ?voxels=URL, window.MLMAP_VOXELS (voxels.js) or a picked voxels.bin.
 
 import { parsePlanes, validatePlanes, PlanesError, type PlanesExport } from './planes';
+import { base64ToBuffer, parseBlocks, parseVoxels, type BlockSet, type VoxelSet } from './blocks';
 
 export interface Loaded {
   data: PlanesExport;
   /** what the data came from, for the title bar: a URL, a file name or "planes.js" */
   origin: string;
+  blocks?: BlockSet;
+  voxels?: VoxelSet;
+  /** why the blocks or voxels beside the planes could not be read; the planes are shown without them */
+  blocksError?: string;
 }
 
 declare global {
   interface Window {
     MLMAP_PLANES?: unknown;
+    MLMAP_BLOCKS?: unknown;
+    MLMAP_VOXELS?: unknown;
   }
 }
 
@@ -55,25 +64,79 @@ export async function loadUrl(url: string): Promise<Loaded> {
   }
 }
 
-/** The export that planes.js put on window, if any. */
-export function loadEmbedded(): Loaded | null {
-  if (window.MLMAP_PLANES === undefined) return null;
+/** Reads a blocks.bin or voxels.bin File; throws PlanesError naming it. */
+export async function loadBinaryFile<T>(file: File, parse: (buffer: ArrayBuffer) => T): Promise<T> {
   try {
-    return { data: validatePlanes(window.MLMAP_PLANES), origin: 'planes.js' };
+    return parse(await file.arrayBuffer());
   } catch (e) {
-    throw new PlanesError(`Could not load planes.js: ${reason(e)}`);
+    throw new PlanesError(`Could not load ${file.name}: ${reason(e)}`);
   }
 }
 
-/** What to show at start-up: ?src=URL first, then planes.js, else nothing (the picker). */
-export async function loadInitial(): Promise<Loaded | null> {
-  const src = new URLSearchParams(location.search).get('src');
-  if (src) return loadUrl(src);
-  return loadEmbedded();
+/** What a picked file holds, told by its first bytes (a planes JSON starts with text). */
+export async function fileKind(file: File): Promise<'planes' | 'blocks' | 'voxels'> {
+  const head = String.fromCharCode(...new Uint8Array(await file.slice(0, 8).arrayBuffer()));
+  if (head === 'MLBLOCKS' || (file.name.endsWith('.bin') && head !== 'MLVOXELS')) return 'blocks';
+  return head === 'MLVOXELS' ? 'voxels' : 'planes';
 }
 
-/** Calls onFile for a file dropped anywhere on the page; marks the body while dragging. */
-export function watchDrops(onFile: (file: File) => void): void {
+async function fetchBinary<T>(url: string, what: string, parse: (buffer: ArrayBuffer) => T): Promise<T> {
+  try {
+    const response = await fetch(url);
+    if (!response.ok) throw new Error(`HTTP ${response.status} ${response.statusText}`.trim());
+    return parse(await response.arrayBuffer());
+  } catch (e) {
+    throw new PlanesError(`Could not load the ${what} ${url}: ${reason(e)}`);
+  }
+}
+
+function embedded<T>(value: unknown, file: string, parse: (buffer: ArrayBuffer) => T): T | undefined {
+  if (value === undefined) return undefined;
+  if (typeof value !== 'string') throw new PlanesError(`Could not load ${file}: it does not hold a base64 string`);
+  try {
+    return parse(base64ToBuffer(value));
+  } catch (e) {
+    throw new PlanesError(`Could not load ${file}: ${reason(e)}`);
+  }
+}
+
+/** The export that planes.js put on window, if any, with the blocks of blocks.js. */
+export function loadEmbedded(): Loaded | null {
+  if (window.MLMAP_PLANES === undefined) return null;
+  let loaded: Loaded;
+  try {
+    loaded = { data: validatePlanes(window.MLMAP_PLANES), origin: 'planes.js' };
+  } catch (e) {
+    throw new PlanesError(`Could not load planes.js: ${reason(e)}`);
+  }
+  try {
+    loaded.blocks = embedded(window.MLMAP_BLOCKS, 'blocks.js', parseBlocks);
+    loaded.voxels = embedded(window.MLMAP_VOXELS, 'voxels.js', parseVoxels);
+  } catch (e) {
+    loaded.blocksError = reason(e);
+  }
+  return loaded;
+}
+
+/** What to show at start-up: ?src=URL (and ?blocks=URL) first, then planes.js, else nothing (the picker). */
+export async function loadInitial(): Promise<Loaded | null> {
+  const params = new URLSearchParams(location.search);
+  const src = params.get('src');
+  if (!src) return loadEmbedded();
+  const loaded = await loadUrl(src);
+  const blocks = params.get('blocks');
+  const voxels = params.get('voxels');
+  try {
+    if (blocks) loaded.blocks = await fetchBinary(blocks, 'blocks', parseBlocks);
+    if (voxels) loaded.voxels = await fetchBinary(voxels, 'voxels', parseVoxels);
+  } catch (e) {
+    loaded.blocksError = reason(e);
+  }
+  return loaded;
+}
+
+/** Calls onFiles for files dropped anywhere on the page; marks the body while dragging. */
+export function watchDrops(onFiles: (files: File[]) => void): void {
   let depth = 0;
   const hasFiles = (e: DragEvent) => Array.from(e.dataTransfer?.types ?? []).includes('Files');
   window.addEventListener('dragenter', (e) => {
@@ -95,7 +158,7 @@ export function watchDrops(onFile: (file: File) => void): void {
     e.preventDefault();
     depth = 0;
     document.body.classList.remove('dragging');
-    const file = e.dataTransfer?.files[0];
-    if (file) onFile(file);
+    const files = Array.from(e.dataTransfer?.files ?? []);
+    if (files.length) onFiles(files);
   });
 }

@@ -1,13 +1,32 @@
-// The 3D view: every patch as its filled outline polygon (metres, z up), a floor grid, the map's
-// bounds as a box, orbit/pan/zoom, and picking a patch by clicking it.
+// The 3D view: every patch as its filled outline polygon (metres, z up), the blocks and voxels layers, a
+// floor grid, the map's bounds as a box, orbit/pan/zoom, a height cut (clipping planes on the
+// patches and blocks), top / side / reset views, measure markers, and picking by clicking.
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import type { Patch, PlanesExport } from './planes';
+import type { Patch, PlaneClass, PlanesExport, Vec3 } from './planes';
 import { patchColour, type ColourMode } from './colours';
+import type { BlockSet, VoxelSet } from './blocks';
+import { BoxLayer, blockBoxes, voxelBoxes } from './block_layer';
+import { BOX_LAYER, OVERLAY_LAYER, Pictures, softwareWebGL } from './pictures';
 
 const HIGHLIGHT = new THREE.Color('#ffe14d');
 const BACKGROUND = new THREE.Color('#1b202a');
+// m, a cut's plane this far away cuts nothing
+const NO_CUT = 1e6;
+
+/** What a click or a probe found: a patch's id (null for an unlabelled block) and the point hit. */
+export interface Hit {
+  id: number | null;
+  point: Vec3;
+  what: 'patch' | 'block' | 'voxel';
+}
+
+export interface Layers {
+  patches: boolean;
+  blocks: boolean;
+  voxels: boolean;
+}
 
 interface PatchObjects {
   patch: Patch;
@@ -46,18 +65,43 @@ export class PlanesView {
   private mode: ColourMode = 'class';
   private selected: number | null = null;
   private visible: Set<number> | null = null;
+  private boxLayers: { what: 'block' | 'voxel'; layer: BoxLayer }[] = [];
+  private layers: Layers = { patches: true, blocks: true, voxels: true };
+  private classOf = new Map<number, PlaneClass>();
+  private home = new THREE.Box3();
+  // Keep z ≤ top and z ≥ bottom (three.js clips where the signed distance is negative).
+  private readonly cutTop = new THREE.Plane(new THREE.Vector3(0, 0, -1), NO_CUT);
+  private readonly cutBottom = new THREE.Plane(new THREE.Vector3(0, 0, 1), NO_CUT);
+  private readonly clipping = [this.cutTop, this.cutBottom];
+  private readonly markers = new THREE.Group();
+  /** WebGL drawn by the CPU (SwiftShader, llvmpipe): no antialiasing, one pixel a CSS pixel. */
+  readonly software: boolean;
+  // Pictures drawn on demand, a big one over several frames (pictures.ts).
+  private readonly pictures: Pictures;
 
-  /** Throws if WebGL cannot start. onPick gets the clicked patch's id, or null for empty space. */
-  constructor(private readonly container: HTMLElement, private readonly onPick: (id: number | null) => void) {
-    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+  /** Throws if WebGL cannot start. onClick gets what a click hit, or null for empty space. */
+  constructor(private readonly container: HTMLElement, private readonly onClick: (hit: Hit | null) => void) {
+    this.software = softwareWebGL();
+    // Multisampling and high-DPI pixels multiply the fragments a CPU must shade: off there.
+    this.renderer = new THREE.WebGLRenderer({ antialias: !this.software, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(this.software ? 1 : Math.min(window.devicePixelRatio, 2));
+    this.renderer.localClippingEnabled = true;
     container.appendChild(this.renderer.domElement);
-    this.scene.background = BACKGROUND;
+    // The clear colour, not scene.background: three.js clears for a background colour at every
+    // render, and a picture drawn over several frames must not be cleared between them.
+    this.renderer.setClearColor(BACKGROUND, 1);
+    this.pictures = new Pictures(this.renderer, this.scene, this.camera,
+      () => this.boxLayers.filter(({ what }) => this.layerShown(what)).map(({ layer }) => layer));
     this.camera.up.set(0, 0, 1);
-    this.scene.add(new THREE.HemisphereLight('#ffffff', '#445066', 1.6));
+    const sky = new THREE.HemisphereLight('#ffffff', '#445066', 1.6);
     const sun = new THREE.DirectionalLight('#ffffff', 1.4);
     sun.position.set(-0.5, -0.8, 1);
-    this.scene.add(sun, this.content);
+    // The lights light every layer; picking sees every layer.
+    sky.layers.enableAll();
+    sun.layers.enableAll();
+    this.raycaster.layers.enableAll();
+    this.scene.add(sky);
+    this.scene.add(sun, this.content, this.markers);
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
     this.controls.addEventListener('change', () => this.render());
     new ResizeObserver(() => this.resize()).observe(container);
@@ -65,8 +109,9 @@ export class PlanesView {
     this.resize();
   }
 
-  show(data: PlanesExport): void {
+  show(data: PlanesExport, blocks: BlockSet | null = null, voxels: VoxelSet | null = null): void {
     this.clear();
+    this.classOf = new Map(data.planes.map((p) => [p.id, p.label]));
     const min = new THREE.Vector3(...data.map.bounds.min);
     const max = new THREE.Vector3(...data.map.bounds.max);
     const box = new THREE.Box3(min, max);
@@ -90,17 +135,80 @@ export class PlanesView {
       const geometry = fillGeometry(patch);
       const fill = new THREE.Mesh(geometry ?? new THREE.BufferGeometry(), new THREE.MeshLambertMaterial({
         side: THREE.DoubleSide, transparent: true, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+        clippingPlanes: this.clipping,
       }));
       fill.userData.id = patch.id;
       const edge = new THREE.LineLoop(
         new THREE.BufferGeometry().setFromPoints(patch.outline.map((p) => new THREE.Vector3(p[0], p[1], p[2]))),
-        new THREE.LineBasicMaterial({ transparent: true }),
+        new THREE.LineBasicMaterial({ transparent: true, clippingPlanes: this.clipping }),
       );
+      fill.layers.set(OVERLAY_LAYER);
+      edge.layers.set(OVERLAY_LAYER);
       this.content.add(fill, edge);
       this.patches.set(patch.id, { patch, fill, edge });
     }
-    this.fit(drawn.isEmpty() ? box : drawn);
+    if (blocks && blocks.count > 0) this.boxLayers.push({ what: 'block', layer: new BoxLayer(blockBoxes(blocks), this.clipping, 'blocks') });
+    if (voxels && voxels.count > 0) this.boxLayers.push({ what: 'voxel', layer: new BoxLayer(voxelBoxes(voxels), this.clipping, 'voxels') });
+    for (const { layer } of this.boxLayers) {
+      layer.mesh.layers.set(BOX_LAYER);
+      this.content.add(layer.mesh);
+    }
+    // Blocks and voxels fill the bounds; patches alone may leave some of it empty.
+    this.home = drawn.isEmpty() ? box : drawn;
+    this.fit(this.home, new THREE.Vector3(-0.45, -0.75, 0.9));
     this.restyle();
+  }
+
+  setLayers(layers: Layers): void {
+    this.layers = { ...layers };
+    this.restyle();
+  }
+
+  /** Hides what lies above top and below bottom (m); ±Infinity for no cut. */
+  setCut(bottom: number, top: number): void {
+    // Finite: an infinite constant turns into NaN when three.js moves the plane to view space.
+    this.cutTop.constant = Math.min(top, NO_CUT);
+    this.cutBottom.constant = Math.min(-bottom, NO_CUT);
+    this.render();
+  }
+
+  /** The camera looking down at the map (north up), from the south, or as first shown. */
+  view(which: 'top' | 'side' | 'reset'): void {
+    const direction = which === 'top' ? new THREE.Vector3(0, -1e-4, 1) : which === 'side' ? new THREE.Vector3(0, -1, 0.02) : new THREE.Vector3(-0.45, -0.75, 0.9);
+    this.fit(this.home, direction);
+    this.render();
+  }
+
+  /** Marks measured points, joined by a line when there are two. */
+  setMarkers(points: Vec3[]): void {
+    for (const child of [...this.markers.children]) {
+      this.markers.remove(child);
+      const obj = child as THREE.Mesh;
+      obj.geometry.dispose();
+      (obj.material as THREE.Material).dispose();
+    }
+    const size = Math.max(0.02, this.home.getSize(new THREE.Vector3()).length() / 150);
+    for (const p of points) {
+      const dot = new THREE.Mesh(new THREE.SphereGeometry(size, 12, 8), new THREE.MeshBasicMaterial({ color: HIGHLIGHT, depthTest: false }));
+      dot.position.set(...p);
+      dot.renderOrder = 10;
+      dot.layers.set(OVERLAY_LAYER);
+      this.markers.add(dot);
+    }
+    if (points.length === 2) {
+      const line = new THREE.Line(new THREE.BufferGeometry().setFromPoints(points.map((p) => new THREE.Vector3(...p))),
+        new THREE.LineBasicMaterial({ color: HIGHLIGHT, depthTest: false }));
+      line.renderOrder = 10;
+      line.layers.set(OVERLAY_LAYER);
+      this.markers.add(line);
+    }
+    this.render();
+  }
+
+  /** The picture, every box drawn, as a PNG blob. */
+  async png(): Promise<Blob> {
+    await this.whenDrawn();
+    return new Promise((resolve, reject) => this.renderer.domElement.toBlob((b) => (b ? resolve(b) : reject(new Error('the view could not be saved'))), 'image/png'));
   }
 
   setColourMode(mode: ColourMode): void {
@@ -127,12 +235,35 @@ export class PlanesView {
 
   /** The patch under a point in client (CSS pixel) coordinates, or null. */
   pickAt(clientX: number, clientY: number): number | null {
+    return this.probe(clientX, clientY)?.id ?? null;
+  }
+
+  /** The nearest shown patch or block under a point in client coordinates, inside the height cut. */
+  probe(clientX: number, clientY: number): Hit | null {
     const rect = this.renderer.domElement.getBoundingClientRect();
     const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
     this.raycaster.setFromCamera(ndc, this.camera);
-    const fills = [...this.patches.values()].filter((o) => o.fill.visible).map((o) => o.fill);
-    const hit = this.raycaster.intersectObjects(fills, false)[0];
-    return hit ? (hit.object.userData.id as number) : null;
+    const top = this.cutTop.constant, bottom = -this.cutBottom.constant;
+    const inCut = (z: number) => z <= top + 1e-6 && z >= bottom - 1e-6;
+    let best: Hit | null = null, bestDistance = Infinity;
+    if (this.layers.patches) {
+      const fills = [...this.patches.values()].filter((o) => o.fill.visible).map((o) => o.fill);
+      const hit = this.raycaster.intersectObjects(fills, false).find((h) => inCut(h.point.z));
+      if (hit) {
+        best = { id: hit.object.userData.id as number, point: hit.point.toArray() as Vec3, what: 'patch' };
+        bestDistance = hit.distance;
+      }
+    }
+    for (const { what, layer } of this.boxLayers) {
+      if (!this.layerShown(what)) continue;
+      const hit = layer.pick(this.raycaster.ray, bottom, top);
+      // A patch lies on its blocks' surface: prefer it when the two are that close.
+      if (hit && hit.distance < bestDistance - 1e-3) {
+        best = { id: hit.plane === 0 ? null : hit.plane, point: hit.point.toArray() as Vec3, what };
+        bestDistance = hit.distance;
+      }
+    }
+    return best;
   }
 
   /** Where a point of the world lands on the page, in client coordinates. */
@@ -142,8 +273,29 @@ export class PlanesView {
     return { x: rect.left + ((p.x + 1) / 2) * rect.width, y: rect.top + ((1 - p.y) / 2) * rect.height };
   }
 
+  /** Where the camera is and what it looks at (for tests). */
+  cameraState(): { position: Vec3; target: Vec3 } {
+    return { position: this.camera.position.toArray() as Vec3, target: this.controls.target.toArray() as Vec3 };
+  }
+
+  /** Asks for a new picture, drawn from the next animation frame on (pictures.ts). */
   render(): void {
-    this.renderer.render(this.scene, this.camera);
+    this.pictures.request();
+  }
+
+  /** Resolves once the picture shows the current state with every box drawn (for tests and the PNG). */
+  whenDrawn(): Promise<void> {
+    return this.pictures.whenDrawn();
+  }
+
+  /** Boxes a frame: a fixed number, or null to size it from the frame times again (for tests). */
+  setFrameBudget(boxes: number | null): void {
+    this.pictures.setBudget(boxes);
+  }
+
+  /** How the picture is drawn: the frames it took (so far), the boxes a frame and whether it is complete. */
+  drawing(): { frames: number; budget: number; complete: boolean } {
+    return this.pictures.state();
   }
 
   private clear(): void {
@@ -157,8 +309,11 @@ export class PlanesView {
       this.content.remove(child);
     }
     this.patches.clear();
+    for (const { layer } of this.boxLayers) layer.dispose();
+    this.boxLayers = [];
     this.selected = null;
     this.visible = null;
+    this.setMarkers([]);
   }
 
   private restyle(): void {
@@ -167,7 +322,7 @@ export class PlanesView {
       const shown = this.visible === null || this.visible.has(id);
       const chosen = id === this.selected;
       const base = new THREE.Color(patchColour(patch, this.mode));
-      fill.visible = edge.visible = shown;
+      fill.visible = edge.visible = shown && this.layers.patches;
       fill.userData.highlighted = chosen && shown;
       fill.material.color.copy(chosen ? HIGHLIGHT : base);
       fill.material.emissive.copy(chosen ? HIGHLIGHT : new THREE.Color(0, 0, 0)).multiplyScalar(chosen ? 0.45 : 0);
@@ -180,18 +335,30 @@ export class PlanesView {
       edge.material.opacity = dimOthers && !chosen ? 0.35 : 1;
       edge.renderOrder = chosen ? 3 : 0;
     }
+    const visible = this.visible;
+    // Unlabelled blocks belong to no patch: a filter that hides some patches hides them too.
+    const filtering = visible !== null && visible.size < this.patches.size;
+    for (const { what, layer } of this.boxLayers) {
+      layer.mesh.visible = this.layerShown(what);
+      layer.recolour(this.mode, (plane) => this.classOf.get(plane), this.selected, HIGHLIGHT);
+      layer.setVisible((plane) => (plane === 0 ? !filtering : visible === null || visible.has(plane)));
+    }
     this.render();
   }
 
-  /** Frames the box: the nearest camera distance, looking from the south-west and above, at
-   * which all its corners land inside the view. */
-  private fit(box: THREE.Box3): void {
+  private layerShown(what: 'block' | 'voxel'): boolean {
+    return what === 'block' ? this.layers.blocks : this.layers.voxels;
+  }
+
+  /** Frames the box: the nearest camera distance, looking along -direction, at which all its
+   * corners land inside the view. */
+  private fit(box: THREE.Box3, towards: THREE.Vector3): void {
     this.resize();
     const centre = box.getCenter(new THREE.Vector3());
     const radius = Math.max(0.5, box.getSize(new THREE.Vector3()).length() / 2);
     const corners = [0, 1, 2, 3, 4, 5, 6, 7].map((i) => new THREE.Vector3(
       i & 1 ? box.max.x : box.min.x, i & 2 ? box.max.y : box.min.y, i & 4 ? box.max.z : box.min.z));
-    const direction = new THREE.Vector3(-0.45, -0.75, 0.9).normalize();
+    const direction = towards.clone().normalize();
     const fits = (distance: number) => {
       this.camera.position.copy(centre).addScaledVector(direction, distance);
       this.camera.lookAt(centre);
@@ -229,7 +396,7 @@ export class PlanesView {
     let down: { x: number; y: number } | null = null;
     canvas.addEventListener('pointerdown', (e) => { down = { x: e.clientX, y: e.clientY }; });
     canvas.addEventListener('pointerup', (e) => {
-      if (down && Math.hypot(e.clientX - down.x, e.clientY - down.y) < 5) this.onPick(this.pickAt(e.clientX, e.clientY));
+      if (down && Math.hypot(e.clientX - down.x, e.clientY - down.y) < 5) this.onClick(this.probe(e.clientX, e.clientY));
       down = null;
     });
   }

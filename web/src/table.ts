@@ -33,6 +33,7 @@ const COLUMNS: Column[] = [
 export class PatchTable {
   private patches: Patch[] = [];
   private rows = new Map<number, HTMLTableRowElement>();
+  private byId = new Map<number, Patch>();
   private sortKey = 'area';
   private descending = true;
   private selected: number | null = null;
@@ -62,6 +63,7 @@ export class PatchTable {
 
   setData(patches: Patch[]): void {
     this.patches = patches;
+    this.byId = new Map(patches.map((p) => [p.id, p]));
     this.selected = null;
     this.rows.clear();
     for (const patch of patches) {
@@ -93,6 +95,17 @@ export class PatchTable {
   /** Shows only the rows of these ids. */
   setVisible(ids: Set<number>): void {
     for (const [id, row] of this.rows) row.hidden = !ids.has(id);
+  }
+
+  /** The rows shown, in the order shown, as CSV: a header line, then the values unrounded. */
+  csv(): string {
+    const lines = ['id,class,cityjson_type,area_m2,normal_x,normal_y,normal_z,height_m,offset_m,blocks,rms_m'];
+    for (const row of Array.from(this.body.rows)) {
+      const p = row.hidden ? undefined : this.byId.get(Number(row.dataset.id));
+      if (!p) continue;
+      lines.push([p.id, p.label, p.cityjson_type ?? '', p.area, ...p.normal, p.centroid[2], p.offset, p.blocks, p.rms].join(','));
+    }
+    return lines.join('\n') + '\n';
   }
 
   select(id: number | null, scroll: boolean): void {

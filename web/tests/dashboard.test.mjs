@@ -6,7 +6,7 @@ import { existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
-import { launchChromium, serveDir, planesJs } from '../scripts/browser.mjs';
+import { launchChromium, serveDir, planesJs, waitDrawn } from '../scripts/browser.mjs';
 
 const web = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const dist = path.join(web, 'dist', 'index.html');
@@ -108,6 +108,7 @@ test('a click on a row highlights its patch in 3D', async () => {
   assert.equal(await page.getAttribute('#view', 'data-highlighted-id'), String(id));
   assert.equal((await state(page)).highlighted, id);
   assert.ok((await page.textContent('#pick-info')).startsWith(`#${id} `));
+  await waitDrawn(page);
   await page.screenshot({ path: path.join(output, 'dashboard-selected.png') });
   await row.click(); // a second click lets go
   assert.equal((await state(page)).highlighted, null);
@@ -209,6 +210,7 @@ test('opened from disk (file://) with planes.js beside it, and without', async (
     await expectLab(page);
     assert.equal((await state(page)).webgl, true);
     await page.waitForTimeout(300);
+    await waitDrawn(page);
     await page.screenshot({ path: path.join(output, 'dashboard.png') });
     await page.close();
   } finally {
