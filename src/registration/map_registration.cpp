@@ -27,6 +27,9 @@ MapRegistration registerMaps(const Map& base, const Map& other, const Pose& init
   // Rooms mapped apart share no frame: the start may be anywhere within the basin (and the
   // retries about it); the answer is verified against the maps' own surface noise.
   BasinConfig basin = config.basin;
+  // Block surfaces sit on the cell grid: their noise is at least the quantisation of a
+  // cell (uniform over it: cell / √12), whatever the scans' range noise was.
+  basin.min_noise = std::max(basin.min_noise, cell_size / std::sqrt(12.0));
   basin.max_start_translation = std::max(basin.max_start_translation, config.max_start_translation);
   const VerifiedIcp verified = alignVerified(source, target, initial_guess, icp, basin);
   const IcpResult& result = verified.icp;

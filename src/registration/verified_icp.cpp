@@ -27,13 +27,18 @@ Pose offsetStart(const Pose& start, double yaw, const Eigen::Vector3d& shift) {
   return pose;
 }
 
-// Better explained: verified first, then the larger explained share; a tie (within a
-// point in a thousand) goes to the smaller spread.
-bool better(const Verification& a, const Verification& b) {
+// Better explained: verified first, then the larger explained share; shares within
+// kShareTie of each other explain the overlap equally well (along a corridor every slide
+// does), and then the result nearer the given start wins: the start is a measurement too.
+constexpr double kShareTie = 0.02;
+double distanceFrom(const Pose& start, const Pose& pose, double radius) {
+  const Pose delta = start.inverse() * pose;
+  return delta.translation().norm() + radius * Eigen::AngleAxisd(delta.linear()).angle();
+}
+bool better(const Verification& a, double a_distance, const Verification& b, double b_distance) {
   if (a.good != b.good) return a.good;
-  const double tie = 1e-3;
-  if (std::abs(a.explained_share - b.explained_share) > tie) return a.explained_share > b.explained_share;
-  return a.spread < b.spread;
+  if (std::abs(a.explained_share - b.explained_share) > kShareTie) return a.explained_share > b.explained_share;
+  return a_distance < b_distance;
 }
 
 double cloudRadius(const std::vector<Point>& source) {
@@ -116,11 +121,15 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
     }
   }
   bool have = false;
+  double kept_distance = 0.0;
+  const double radius = cloudRadius(source);
   for (const Pose& from : starts) {
     const IcpResult result = alignPoints(source, target, from, wide);
     ++out.attempts;
     const Verification check = verifyAlignment(source, target, result.pose, sigma, gate, config);
-    if (!have || better(check, out.check)) {
+    const double distance = distanceFrom(start, result.pose, radius);
+    if (!have || better(check, distance, out.check, kept_distance)) {
+      kept_distance = distance;
       out.icp = result;
       out.check = check;
       out.kept_start = from;
