@@ -15,6 +15,9 @@ constexpr double kMadToSigma = 1.4826;
 // The noise is measured on every this-many-th voxel of the target: a few thousand voxels
 // give the median to a few per cent.
 constexpr std::size_t kNoiseStride = 4;
+// m, the most the start's yaw error adds to the first gate: a source far from its own
+// origin (a map 60 m away) would otherwise make every search visit thousands of voxels.
+constexpr double kMaxYawReach = 1.5;
 
 double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
@@ -107,7 +110,8 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
 
   IcpConfig wide = icp;
   wide.initial_max_distance = std::max(
-      icp.initial_max_distance, config.max_start_translation + cloudRadius(source) * radians(config.max_start_yaw_deg));
+      icp.initial_max_distance,
+      config.max_start_translation + std::min(kMaxYawReach, cloudRadius(source) * radians(config.max_start_yaw_deg)));
 
   std::vector<Pose> starts{start};
   if (config.retry) {
