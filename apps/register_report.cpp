@@ -21,7 +21,11 @@ nlohmann::json poseJson(const Pose& pose) {
 std::string verificationSummary(const registration::VerifiedIcp& result) {
   char text[256];
   std::snprintf(text, sizeof text, "%s: %.0f %% explained, residual spread %.2f cm (noise %.2f cm), %d ICP run%s%s",
-                result.verified ? "verified" : "NOT VERIFIED", 100.0 * result.check.explained_share,
+                result.verified        ? "verified"
+                : result.unconstrained ? "UNCONSTRAINED (a direction is free)"
+                : result.no_overlap    ? "NO OVERLAP"
+                                       : "NOT VERIFIED",
+                100.0 * result.check.explained_share,
                 100.0 * result.check.spread, 100.0 * result.noise, result.attempts, result.attempts == 1 ? "" : "s",
                 result.icp.degenerate ? ", degenerate geometry" : "");
   return text;
@@ -54,7 +58,10 @@ void writeRegisterReport(const std::string& path, const std::vector<ScanReport>&
                             {"converged", r.icp.converged},
                             {"degenerate", r.icp.degenerate},
                             {"eigenvalue_ratio", r.icp.eigenvalue_ratio},
+                            {"constrained_eigenvalue_ratio", r.check.eigenvalue_ratio},
                             {"verified", r.verified},
+                            {"unconstrained", r.unconstrained},
+                            {"no_overlap", r.no_overlap},
                             {"reason", r.reason}});
   }
   if (refinement != nullptr) {

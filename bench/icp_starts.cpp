@@ -104,6 +104,10 @@ int runIcpStarts(int argc, char** argv) {
         run["explained"] = result.check.explained_share;
         run["spread"] = result.check.spread;
         run["noise"] = result.noise;
+        run["first_matched"] = result.first_matched_share;
+        run["eigenvalue_ratio"] = result.check.eigenvalue_ratio;
+        run["unconstrained"] = result.unconstrained;
+        run["no_overlap"] = result.no_overlap;
       }
       const double icp_seconds = secondsSince(icp_start);
       run["seconds"] = {{"prepare", prep_seconds}, {"icp", icp_seconds}, {"total", prep_seconds + icp_seconds}};

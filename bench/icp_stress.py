@@ -232,7 +232,7 @@ def main():
         if not peers:
             print(f"(no peers in {a.peers_build}: mlmap only)")
     methods = ["mlmap"] + (["mlmap --plain"] if a.plain else []) + peers
-    rows = []  # (scene, size, method, t_cm, r_deg, seconds, verified, attempts)
+    rows = []  # (scene, size, method, t_cm, r_deg, seconds, verified, attempts, unconstrained, first matched share)
     loads = [os.getloadavg()[0]]
     started = time.time()
     for name, scene in scenes_for(a.split, a.scenes.split(",")):
@@ -269,7 +269,8 @@ def main():
                 out = json.loads(run([bench, "icp-starts", jobs_path] + (["--plain"] if "plain" in method else []), env))
                 for (pair, size, T_true, S), res in zip(starts_meta, out["runs"]):
                     t, r = errors(T_true, res["matrix"])
-                    rows.append((name, size, method, t, r, res["seconds"]["total"], res["verified"], res["attempts"]))
+                    rows.append((name, size, method, t, r, res["seconds"]["total"], res["verified"], res["attempts"],
+                                 res.get("unconstrained"), res.get("first_matched")))
                 continue
             for k, (pair, size, T_true, S) in enumerate(starts_meta):
                 i, j = map(int, pair.split("-"))
@@ -282,7 +283,7 @@ def main():
                                       os.path.join(scene_dir, f"scan_{i:03d}.xyz"), "--poses", poses,
                                       "--source-index", "1", "--target-index", "0", "--threads", str(a.threads)], env))
                 t, r = errors(T_true, res["relative_pose"]["matrix"])
-                rows.append((name, size, method, t, r, res["seconds"]["total"], None, 1))
+                rows.append((name, size, method, t, r, res["seconds"]["total"], None, 1, None, None))
         print(f"  {name}: {len(starts_meta)} starts on {len(chosen)} pairs done ({time.time() - started:.0f} s)",
               file=sys.stderr)
 
@@ -293,8 +294,8 @@ def main():
           "(reading excluded), median")
     print()
     print("| scene | start | method | success | t err cm median | t err cm max | rot err deg median | "
-          "rot err deg max | s/pair | verified (false) | ICP runs |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          "rot err deg max | s/pair | verified (false) | unconstrained | ICP runs | first matched min |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     keys = []
     for row in rows:
         if (row[0], row[1]) not in keys:
@@ -312,16 +313,20 @@ def main():
                 false = sum(1 for r, good in zip(sel, ok) if r[6] and not good)
                 ver = f"{sum(v)}/{len(v)} ({false})"
             runs = f"{np.mean([r[7] for r in sel]):.1f}" if method == "mlmap" else ""
+            free = f"{sum(1 for r in sel if r[8])}" if method == "mlmap" else ""
+            shares = [r[9] for r in sel if r[9] is not None]
+            first = f"{min(shares):.2f}" if method == "mlmap" and shares else ""
             print(f"| {scene} | {size} | {method} | {sum(ok)}/{len(ok)} | {np.median([r[3] for r in sel]):.2f} | "
                   f"{max(r[3] for r in sel):.1f} | {np.median([r[4] for r in sel]):.3f} | "
-                  f"{max(r[4] for r in sel):.2f} | {np.median([r[5] for r in sel]):.3f} | {ver} | {runs} |")
+                  f"{max(r[4] for r in sel):.2f} | {np.median([r[5] for r in sel]):.3f} | {ver} | {free} | {runs} | {first} |")
             totals[(scene, size, method)] = np.median([r[5] for r in sel])
     for peer in peers:
         ratio = [totals[("all", s, peer)] / totals[("all", s, "mlmap")] for s in ("small", "large")
                  if ("all", s, peer) in totals]
         print(f"\n{peer} time / mlmap time (median per run, small / large starts): "
               + " / ".join(f"{x:.1f}x" for x in ratio))
-    print(f"\n(work directory: {work})")
+    json.dump(rows, open(os.path.join(work, f"rows_{a.split}.json"), "w"))
+    print(f"\n(work directory: {work}; per run: rows_{a.split}.json)")
 
 
 if __name__ == "__main__":

@@ -136,7 +136,10 @@ RefinementResult SequenceRegistration::refine() {
       const IcpResult& icp = pair_results[p].icp;
       const double overlap =
           icp.source_points > 0 ? static_cast<double>(icp.inliers) / static_cast<double>(icp.source_points) : 0.0;
-      if (!pair_results[p].verified || !icp.converged || icp.inliers < config_.icp.min_inliers ||
+      // An unconstrained pair (explained, one direction free) still measures the others:
+      // its information leaves out the free direction (icpInformation).
+      const bool explained = pair_results[p].verified || pair_results[p].unconstrained;
+      if (!explained || !icp.converged || icp.inliers < config_.icp.min_inliers ||
           overlap < config_.min_overlap) {
         ++result.rejected_pairs;
         continue;

@@ -19,7 +19,11 @@ struct MapRegistrationConfig {
   std::size_t min_inliers = 200;
   // The start may be this far off (m) and the basin's yaw plus the retries' off in yaw.
   double max_start_translation = 1.0;
-  BasinConfig basin{.retry_yaw_deg = {20.0, -20.0, 10.0, -10.0, 30.0, -30.0}, .retry_translation = 0.6};
+  // The retries step by 10 deg: a basin of half that covers the yaw between them, at a
+  // third of the search cost of 10 deg over a map's radius (the gate's cube).
+  BasinConfig basin{.max_start_yaw_deg = 5.0,
+                    .retry_yaw_deg = {20.0, -20.0, 10.0, -10.0, 30.0, -30.0},
+                    .retry_translation = 0.6};
 };
 
 struct MapRegistration {
