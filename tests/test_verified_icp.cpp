@@ -143,3 +143,33 @@ TEST_CASE("alignVerified: a wrong pose is not verified, and says why") {
   CHECK_FALSE(result.reason.empty());
   CHECK(result.attempts == 1);
 }
+
+TEST_CASE("alignVerified: a bare corridor is unconstrained, not verified; clouds apart are no overlap") {
+  // 30 m of bare corridor: nothing fixes the position along it. Before the eigenvalue
+  // check such results were called verified wherever ICP left them.
+  const Pair corridor = simulatedPair(R"({
+    "scan_pattern": {"angular_step_deg": 1.0, "tilt_start_deg": -50, "tilt_end_deg": 50,
+                     "tilt_step_deg": 2.0, "range_sigma": 0.01, "mount_height": 1.2, "max_range": 8},
+    "poses": [{"x": 12.0, "y": 1.1}, {"x": 13.5, "y": 1.0, "yaw_deg": 3}],
+    "surfaces": [
+      {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [30, 2.2, 0]},
+      {"type": "rectangle", "class": "ceiling", "min": [0, 0, 2.8], "max": [30, 2.2, 2.8]},
+      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [30, 0, 2.8]},
+      {"type": "rectangle", "class": "wall", "min": [0, 2.2, 0], "max": [30, 2.2, 2.8]}
+    ]
+  })");
+  const VerifiedIcp slid = alignVerified(corridor.source, corridor.target,
+                                         startOff(corridor.true_pose, {0.3, 0.05, 0.0}, 2.0));
+  CHECK_FALSE(slid.verified);
+  CHECK(slid.unconstrained);
+  CHECK(slid.attempts == 1);  // no start can fix what the geometry does not measure
+  CHECK(slid.check.eigenvalue_ratio < 1e-3);
+  CHECK(slid.reason.find("unconstrained") != std::string::npos);
+
+  // The room's scan placed 60 m away matches nothing: one run, no retries.
+  const Pair room = simulatedPair(kRoomJson);
+  const VerifiedIcp apart = alignVerified(room.source, room.target, startOff(room.true_pose, {60.0, 0.0, 0.0}, 0.0));
+  CHECK_FALSE(apart.verified);
+  CHECK(apart.no_overlap);
+  CHECK(apart.attempts == 1);
+}
