@@ -32,11 +32,10 @@ std::vector<io::StampedPose> registeredPoses(const BuildOptions& options, const 
   reading.forEach(
       [&](Scan& scan, std::size_t index, std::size_t file) {
         corrected.push_back({given.empty() ? static_cast<double>(index) : given[index].stamp, scan.pose});
-        const registration::IcpResult result = sequence.addScan(scan.points, scan.pose);
-        if (result.unreliable && !quiet) {
-          std::fprintf(stderr, "register: scan %zu (%s) is unreliable: %zu inliers%s\n", index,
-                       options.input.scans[file].c_str(), result.inliers,
-                       result.degenerate ? ", degenerate geometry" : "");
+        const registration::VerifiedIcp result = sequence.addScan(scan.points, scan.pose);
+        if (!result.verified && !quiet) {
+          std::fprintf(stderr, "register: scan %zu (%s) is not verified: %s\n", index,
+                       options.input.scans[file].c_str(), result.reason.c_str());
         }
       },
       [&](std::size_t file) { progress.update(file + 1); });

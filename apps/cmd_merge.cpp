@@ -59,6 +59,10 @@ int runMerge(const MergeArguments& arguments, bool quiet) {
     std::printf("  ICP: %zu of %zu surface samples matched, RMS %.2f cm, overlap %.1f %%, %.2f s%s\n", found.inliers,
                 found.samples, 100.0 * found.rms_residual, 100.0 * found.overlap, seconds(icp_start),
                 found.reliable ? "" : " — UNRELIABLE");
+    std::printf("  verification: %s, %.0f %% of the samples explained, residual spread %.2f cm (surface noise %.2f cm), "
+                "%d ICP run%s\n",
+                found.verified ? "verified" : "NOT VERIFIED", 100.0 * found.explained_share,
+                100.0 * found.residual_spread, 100.0 * found.noise, found.attempts, found.attempts == 1 ? "" : "s");
     if (!found.reliable) {
       if (!arguments.force) {
         throw Error("registration unreliable: " + found.reason +

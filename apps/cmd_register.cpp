@@ -1,6 +1,7 @@
 // mlmap register: scans + odometry poses -> corrected poses (TUM), by scan-to-map ICP and
 // a pose graph over overlapping pairs.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "commands.hpp"
@@ -8,6 +9,7 @@
 #include "mlmap/io/tum_poses.hpp"
 #include "mlmap/registration/sequence_registration.hpp"
 #include "mlmap/registration/trajectory_error.hpp"
+#include "register_report.hpp"
 #include "progress.hpp"
 #include "scan_options.hpp"
 
@@ -18,6 +20,7 @@ struct RegisterOptions {
   std::string output;
   ScanOptions input;
   std::string reference;
+  std::string report;
   std::string metric = "point-to-plane";
   bool no_refine = false;
   registration::SequenceConfig config;
@@ -49,36 +52,42 @@ int runRegister(RegisterOptions options, bool quiet) {
   std::vector<Pose> odometry_poses;
   double register_seconds = 0.0;
   std::size_t point_count = 0;
+  std::vector<ScanReport> reports;
   Progress progress("register", options.input.scans.size(), !quiet);
   reading.forEach(
-      [&](Scan& scan, std::size_t index, std::size_t) {
+      [&](Scan& scan, std::size_t index, std::size_t file) {
         const io::StampedPose guess{odometry.empty() ? static_cast<double>(index) : odometry[index].stamp, scan.pose};
         const auto start = std::chrono::steady_clock::now();
-        const registration::IcpResult result = sequence.addScan(scan.points, guess.pose);
+        const registration::VerifiedIcp result = sequence.addScan(scan.points, guess.pose);
         register_seconds += secondsSince(start);
         point_count += scan.size();
         stamped.push_back(guess);
         odometry_poses.push_back(guess.pose);
-        if (!quiet || result.unreliable) {
-          std::fprintf(stderr, "scan %zu: %zu points, %zu/%zu inliers, RMS %.2f cm, %d iterations%s%s\n", index,
-                       scan.size(), result.inliers, result.source_points, 100.0 * result.rms_residual,
-                       result.iterations, result.degenerate ? ", degenerate" : "",
-                       result.unreliable ? ", UNRELIABLE" : "");
-        }
+        // Printed for every scan (stdout): whether its result explains the overlap.
+        std::printf("scan %zu: %zu points, %zu/%zu inliers, RMS %.2f cm, %d iterations, %s\n", index, scan.size(),
+                    result.icp.inliers, result.icp.source_points, 100.0 * result.icp.rms_residual,
+                    result.icp.iterations, index == 0 ? "first scan (anchors the map)" : verificationSummary(result).c_str());
+        reports.push_back({index, options.input.scans[file], scan.size(), result});
       },
       [&](std::size_t file) { progress.update(file + 1, std::to_string(point_count) + " points"); });
   progress.finish(std::to_string(point_count) + " points");
   const std::vector<Pose> sequential = sequence.poses();
 
   double refine_seconds = 0.0;
+  registration::RefinementResult refinement;
   if (!options.no_refine) {
     const auto start = std::chrono::steady_clock::now();
-    const registration::RefinementResult refinement = sequence.refine();
+    refinement = sequence.refine();
     refine_seconds = secondsSince(start);
-    std::printf("refinement: %zu pair edges (%zu pairs rejected), graph cost %.4g -> %.4g in %.2f s\n",
-                refinement.pair_edges, refinement.rejected_pairs, refinement.graph.initial_cost,
-                refinement.graph.final_cost, refine_seconds);
+    std::printf("refinement: %zu verified pair edges (%zu loop closures, %zu pairs rejected), graph cost %.4g -> %.4g, "
+                "pair residual RMS %.2f -> %.2f cm (%s) in %.2f s\n",
+                refinement.pair_edges, refinement.loop_edges, refinement.rejected_pairs, refinement.graph.initial_cost,
+                refinement.graph.final_cost, 100.0 * std::sqrt(refinement.residual_before),
+                100.0 * std::sqrt(refinement.residual_after),
+                refinement.rounds_applied > 0 ? "applied" : "kept the scan-to-map poses: the graph did not lower it",
+                refine_seconds);
   }
+  if (!options.report.empty()) writeRegisterReport(options.report, reports, options.no_refine ? nullptr : &refinement);
   for (std::size_t i = 0; i < stamped.size(); ++i) stamped[i].pose = sequence.poses()[i];
   io::writeTumPoses(options.output, stamped);
   std::printf("%s: %zu scans, %zu points; scan-to-map %.3f s per scan, refinement %.2f s\n",
@@ -115,10 +124,12 @@ void addRegisterCommand(CLI::App& app, Context& context) {
       ->default_val(0.1)
       ->check(CLI::PositiveNumber);
   command->add_option("--max-distance", options->config.icp.initial_max_distance,
-                      "Initial correspondence distance, m: a bound on the odometry error")
+                      "Smallest first correspondence gate, m (the gate follows the start's error bound: 0.5 m, 10 deg)")
       ->default_val(0.5)
       ->check(CLI::PositiveNumber);
   command->add_flag("--no-refine", options->no_refine, "Scan-to-map only, no pose graph");
+  command->add_option("--report", options->report,
+                      "Write the per-scan figures (start, result, inliers, residual, retries, verified) as JSON");
   addScanOptions(command, options->input,
                  {.poses_help = "Odometry poses (TUM), one per scan in order; without it each scan's own pose",
                   .identity = false});

@@ -3,6 +3,7 @@
 //   mlmap_bench icp SCENE_DIR [--runs N]   (pairwise ICP, see icp_pairs.cpp)
 //   mlmap_bench octree --poses POSES.txt SCAN...   (the OcTree layer alone, see octree_insert.cpp)
 //   mlmap_bench pacing [SCENE.json] [--seconds S] [--time-scale X]   (emulator_pacing.cpp)
+//   mlmap_bench icp-starts JOBS.json [--plain]   (ICP from given starts, see icp_starts.cpp)
 // Simulates the scene (default maps/lab.json), then times insertion into the block
 // layer alone and the OcTree alone on the same points, and reports map sizes at
 // several cell sizes.
@@ -16,6 +17,7 @@
 
 #include "icp_pairs.hpp"
 #include "octree_insert.hpp"
+#include "icp_starts.hpp"
 #include "threads.hpp"
 #include "mlmap/map/map.hpp"
 #include "mlmap/sim/scene.hpp"
@@ -63,6 +65,14 @@ int main(int argc, char** argv) {
     }
   }
   if (argc > 1 && std::strcmp(argv[1], "octree") == 0) return mlmap::bench::runOctreeInsert(argc - 1, argv + 1);
+  if (argc > 1 && std::strcmp(argv[1], "icp-starts") == 0) {
+    try {
+      return mlmap::bench::runIcpStarts(argc - 1, argv + 1);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "mlmap_bench icp-starts: %s\n", error.what());
+      return 1;
+    }
+  }
   std::string scene_path = std::string(MLMAP_SOURCE_DIR) + "/maps/lab.json";
   bool quick = false;
   for (int k = 1; k < argc; ++k) {

@@ -106,6 +106,23 @@ TEST_CASE("Merge: ICP places the other room, the shared walls become one plane, 
   CHECK_FALSE(merged.octree().isNodeOccupied(middle));
 }
 
+TEST_CASE("Merge: ICP places the other room from the identity, frames up to 1 m and 30 degrees apart") {
+  // Rooms mapped apart share no frame: no --initial, the start is the identity.
+  const Map base = mapOf({0, 1}, Pose::Identity(), false);
+  // One frame (the -22 deg frame, which needs the yaw retries, costs 4 wide ICP runs on
+  // 10 000 map points: bench/icp_stress.py holds the many-start cases).
+  for (const Pose& b_frame : {yawPose(0.7, -0.6, 0.0, 28.0)}) {
+    CAPTURE(yawDeg(b_frame));
+    const Map other = mapOf({2, 3}, b_frame, false);
+    const registration::MapRegistration found = registration::registerMaps(base, other, Pose::Identity());
+    INFO("reason: " << found.reason);
+    CHECK(found.reliable);
+    CHECK(found.verified);
+    CHECK((found.other_to_base.translation() - b_frame.translation()).norm() < 0.03);
+    CHECK(std::abs(yawDeg(found.other_to_base) - yawDeg(b_frame)) < 0.3);
+  }
+}
+
 TEST_CASE("Merge: maps that do not overlap are not registered") {
   const Map base = mapOf({0, 1}, Pose::Identity(), false);
   const Map far_away = mapOf({2, 3}, yawPose(60.0, 0.0, 0.0, 0.0), false);

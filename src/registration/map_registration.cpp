@@ -24,7 +24,15 @@ MapRegistration registerMaps(const Map& base, const Map& other, const Pose& init
   icp.min_max_distance = std::max(0.1, 2.0 * cell_size);
   icp.min_kernel_scale = std::max(0.01, cell_size / 2.0);
   icp.min_inliers = config.min_inliers;
-  const IcpResult result = alignPoints(source, target, initial_guess, icp);
+  // Rooms mapped apart share no frame: the start may be anywhere within the basin (and the
+  // retries about it); the answer is verified against the maps' own surface noise.
+  BasinConfig basin = config.basin;
+  // Block surfaces sit on the cell grid: their noise is at least the quantisation of a
+  // cell (uniform over it: cell / √12), whatever the scans' range noise was.
+  basin.min_noise = std::max(basin.min_noise, cell_size / std::sqrt(12.0));
+  basin.max_start_translation = std::max(basin.max_start_translation, config.max_start_translation);
+  const VerifiedIcp verified = alignVerified(source, target, initial_guess, icp, basin);
+  const IcpResult& result = verified.icp;
 
   MapRegistration registration;
   registration.other_to_base = result.pose;
@@ -32,6 +40,11 @@ MapRegistration registerMaps(const Map& base, const Map& other, const Pose& init
   registration.inliers = result.inliers;
   registration.samples = source.size();
   registration.degenerate = result.degenerate;
+  registration.verified = verified.verified;
+  registration.explained_share = verified.check.explained_share;
+  registration.residual_spread = verified.check.spread;
+  registration.noise = verified.noise;
+  registration.attempts = verified.attempts;
   const double overlap_distance = config.overlap_distance > 0.0 ? config.overlap_distance
                                                                 : std::max(0.1, 2.0 * cell_size);
   std::size_t near = 0;
@@ -49,6 +62,8 @@ MapRegistration registerMaps(const Map& base, const Map& other, const Pose& init
                           " % of the other map's surface lies near the base map's)";
   } else if (result.inliers < config.min_inliers) {
     registration.reason = "too few ICP inliers (" + std::to_string(result.inliers) + ")";
+  } else if (!verified.verified) {
+    registration.reason = verified.reason;
   } else if (result.degenerate) {
     registration.reason = "the overlap does not constrain every direction (degenerate, e.g. a featureless corridor)";
   } else if (!result.converged) {

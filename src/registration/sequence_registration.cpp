@@ -1,12 +1,17 @@
 #include "mlmap/registration/sequence_registration.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "mlmap/registration/preprocessing.hpp"
 
 namespace mlmap::registration {
 namespace {
+
+// A pair residual is truncated at this many expected residual spreads (√2 × the noise).
+constexpr double kResidualSigmas = 3.0;
 
 std::vector<Point> transformed(const std::vector<Point>& points, const Pose& pose) {
   std::vector<Point> result;
@@ -40,24 +45,25 @@ Matrix6d icpInformation(const IcpResult& result, double min_sigma, double min_ei
 SequenceRegistration::SequenceRegistration(const SequenceConfig& config)
     : config_(config), map_(config.map_voxel_size, config.max_points_per_voxel) {}
 
-IcpResult SequenceRegistration::addScan(const std::vector<Point>& points, const Pose& odometry) {
+VerifiedIcp SequenceRegistration::addScan(const std::vector<Point>& points, const Pose& odometry) {
   // The map and the local maps take a finer sample than the ICP source: their normals
   // need neighbours.
   const std::vector<Point> dense =
       voxelDownSample(points, config_.map_voxel_size / 2.0, config_.min_range, config_.max_range);
   std::vector<Point> source = voxelDownSample(points, config_.source_voxel_size, config_.min_range, config_.max_range);
 
-  IcpResult result;
+  VerifiedIcp result;
   Pose pose = odometry;
   if (poses_.empty()) {
-    result.pose = pose;
-    result.converged = true;
-    result.unreliable = false;
-    result.source_points = source.size();
+    result.icp.pose = result.start = result.kept_start = pose;
+    result.icp.converged = true;
+    result.icp.unreliable = false;
+    result.icp.source_points = source.size();
+    result.verified = true;
   } else {
     const Pose guess = poses_.back() * (odometry_.back().inverse() * odometry);
-    result = alignPoints(source, map_, guess, config_.icp);
-    pose = result.pose;
+    result = alignVerified(source, map_, guess, config_.icp, config_.basin);
+    pose = result.icp.pose;
   }
   map_.addPoints(transformed(dense, pose));
   map_.estimateNormals(config_.normals);
@@ -74,12 +80,20 @@ RefinementResult SequenceRegistration::refine() {
   if (poses_.size() < 2) return result;
   IcpConfig pair_config = config_.icp;
   pair_config.initial_max_distance = std::max(config_.icp.min_max_distance, 0.25);
-  // Each scan alone in its sensor frame: the targets of the pairwise ICP.
+  // The poses are already registered: a pair is checked, not searched for again.
+  BasinConfig pair_basin = config_.basin;
+  pair_basin.retry = false;
+  pair_basin.max_start_translation = 0.0;
+  pair_basin.max_start_yaw_deg = 0.0;
+  // Each scan alone in its sensor frame: the targets of the pairwise ICP, with its noise.
   std::vector<VoxelHashMap> locals;
+  std::vector<double> noise;
   for (const std::vector<Point>& dense : dense_) {
     locals.emplace_back(config_.map_voxel_size, config_.max_points_per_voxel);
     locals.back().addPoints(dense);
     locals.back().estimateNormals(config_.normals);
+    noise.push_back(config_.basin.noise > 0.0 ? config_.basin.noise
+                                              : std::max(config_.basin.min_noise, locals.back().planeNoise(4)));
   }
   for (int round = 0; round < config_.refinement_rounds; ++round) {
     std::vector<PoseGraphEdge> edges;
@@ -95,7 +109,8 @@ RefinementResult SequenceRegistration::refine() {
           Eigen::Vector3d::Constant(1.0 / translation_sq);
       edges.push_back(edge);
     }
-    // Candidate pairs, then pairwise ICP in parallel (each pair writes only its own slot).
+    // Candidate pairs (consecutive or not: a scan that sees an earlier one's space again
+    // closes a loop), then pairwise ICP in parallel (each pair writes only its own slot).
     std::vector<std::pair<std::size_t, std::size_t>> pairs;
     for (std::size_t i = 0; i < poses_.size(); ++i) {
       for (std::size_t j = i + 1; j < poses_.size(); ++j) {
@@ -104,20 +119,28 @@ RefinementResult SequenceRegistration::refine() {
         }
       }
     }
-    std::vector<IcpResult> pair_results(pairs.size());
-#pragma omp parallel for schedule(dynamic, 1)
+    std::vector<VerifiedIcp> pair_results(pairs.size());
+    BasinConfig basin = pair_basin;
+#pragma omp parallel for schedule(dynamic, 1) firstprivate(basin)
     for (long p = 0; p < static_cast<long>(pairs.size()); ++p) {
       const auto [i, j] = pairs[static_cast<std::size_t>(p)];
+      basin.noise = noise[i];
       pair_results[static_cast<std::size_t>(p)] =
-          alignPoints(sources_[j], locals[i], poses_[i].inverse() * poses_[j], pair_config);
+          alignVerified(sources_[j], locals[i], poses_[i].inverse() * poses_[j], pair_config, basin);
     }
     result.pair_edges = 0;
+    result.loop_edges = 0;
     result.rejected_pairs = 0;
+    std::vector<std::pair<std::size_t, std::size_t>> verified_pairs;
     for (std::size_t p = 0; p < pairs.size(); ++p) {
-      const IcpResult& icp = pair_results[p];
+      const IcpResult& icp = pair_results[p].icp;
       const double overlap =
           icp.source_points > 0 ? static_cast<double>(icp.inliers) / static_cast<double>(icp.source_points) : 0.0;
-      if (!icp.converged || icp.inliers < config_.icp.min_inliers || overlap < config_.min_overlap) {
+      // An unconstrained pair (explained, one direction free) still measures the others:
+      // its information leaves out the free direction (icpInformation).
+      const bool explained = pair_results[p].verified || pair_results[p].unconstrained;
+      if (!explained || !icp.converged || icp.inliers < config_.icp.min_inliers ||
+          overlap < config_.min_overlap) {
         ++result.rejected_pairs;
         continue;
       }
@@ -129,11 +152,53 @@ RefinementResult SequenceRegistration::refine() {
       edge.information = icpInformation(icp, config_.icp.min_kernel_scale, config_.icp.min_eigenvalue_ratio,
                                         icp.radius);
       edges.push_back(edge);
+      verified_pairs.push_back(pairs[p]);
       ++result.pair_edges;
+      if (edge.to != edge.from + 1) ++result.loop_edges;
     }
-    result.graph = optimizePoseGraph(poses_, edges);
+    std::vector<Pose> candidate = poses_;
+    result.graph = optimizePoseGraph(candidate, edges);
+    // Kept only where it lowers the residuals of the verified pairs: the graph weighs the
+    // chain and the pairs by models of their uncertainty, the residuals are what is measured.
+    const double before = pairResidual(verified_pairs, poses_, locals, noise);
+    const double after = pairResidual(verified_pairs, candidate, locals, noise);
+    if (round == 0) result.residual_before = before;
+    if (after < before) {
+      poses_ = std::move(candidate);
+      result.residual_after = after;
+      ++result.rounds_applied;
+    } else {
+      result.residual_after = before;
+      break;
+    }
   }
   return result;
+}
+
+double SequenceRegistration::pairResidual(const std::vector<std::pair<std::size_t, std::size_t>>& pairs,
+                                          const std::vector<Pose>& poses, const std::vector<VoxelHashMap>& locals,
+                                          const std::vector<double>& noise) const {
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (const auto& [i, j] : pairs) {
+    // Residuals beyond a few σ are points the other scan does not see: they count as
+    // that bound, so a pose that moves a point out of overlap gains nothing.
+    const double bound = kResidualSigmas * std::sqrt(2.0) * noise[i];
+    const double bound_sq = bound * bound;
+    const Pose relative = poses[i].inverse() * poses[j];
+    for (const Point& point : sources_[j]) {
+      const Point moved = relative * point;
+      const std::optional<Neighbour> neighbour = locals[i].nearest(moved, config_.icp.min_max_distance);
+      double r_sq = bound_sq;
+      if (neighbour && !neighbour->normal.isZero()) {
+        const double r = neighbour->normal.dot(moved - neighbour->point);
+        r_sq = std::min(bound_sq, r * r);
+      }
+      sum += r_sq;
+      ++count;
+    }
+  }
+  return count > 0 ? sum / static_cast<double>(count) : 0.0;
 }
 
 }  // namespace mlmap::registration

@@ -235,6 +235,28 @@ void VoxelHashMap::estimateNormals(const NormalConfig& config) {
   std::fill(dirty_.begin(), dirty_.end(), 0);
 }
 
+double VoxelHashMap::planeNoise(std::size_t stride) const {
+  std::vector<double> distances;
+  stride = std::max<std::size_t>(1, stride);
+  for (std::size_t v = 0; v < table_.size(); v += stride) {
+    const std::size_t count = pointsIn(v);
+    if (count < 3 || normals_[v].isZero()) continue;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (std::uint32_t k = begin_[v]; k < begin_[v + 1]; ++k) mean += points_[k];
+    mean /= static_cast<double>(count);
+    // n points about their mean have n − 1 degrees of freedom along the normal: scale so
+    // the spread estimates the noise of one point, not of its deviation from the mean.
+    const double dof = std::sqrt(static_cast<double>(count) / static_cast<double>(count - 1));
+    for (std::uint32_t k = begin_[v]; k < begin_[v + 1]; ++k) {
+      distances.push_back(dof * std::abs(normals_[v].dot(points_[k] - mean)));
+    }
+  }
+  if (distances.empty()) return 0.0;
+  auto middle = distances.begin() + static_cast<long>(distances.size() / 2);
+  std::nth_element(distances.begin(), middle, distances.end());
+  return 1.4826 * *middle;  // MAD -> standard deviation of a Gaussian
+}
+
 std::vector<Point> VoxelHashMap::points() const { return points_; }
 
 }  // namespace mlmap::registration

@@ -8,6 +8,7 @@
 
 #include "mlmap/map/map.hpp"
 #include "mlmap/registration/icp.hpp"
+#include "mlmap/registration/verified_icp.hpp"
 
 namespace mlmap::registration {
 
@@ -16,6 +17,13 @@ struct MapRegistrationConfig {
   double overlap_distance = 0.0;      // m, a point overlaps within this of the base; 0 = 2 cells, at least 0.1
   double min_overlap = 0.01;          // fraction of the other map's surface samples; less: unreliable
   std::size_t min_inliers = 200;
+  // The start may be this far off (m) and the basin's yaw plus the retries' off in yaw.
+  double max_start_translation = 1.0;
+  // The retries step by 10 deg: a basin of half that covers the yaw between them, at a
+  // third of the search cost of 10 deg over a map's radius (the gate's cube).
+  BasinConfig basin{.max_start_yaw_deg = 5.0,
+                    .retry_yaw_deg = {20.0, -20.0, 10.0, -10.0, 30.0, -30.0},
+                    .retry_translation = 0.6};
 };
 
 struct MapRegistration {
@@ -25,6 +33,11 @@ struct MapRegistration {
   std::size_t inliers = 0;
   std::size_t samples = 0;     // surface samples of the other map used
   bool degenerate = false;
+  bool verified = false;       // the result explains the overlap (see alignVerified)
+  double explained_share = 0.0;  // of the other map's samples, within 3 σ of the base's surfaces
+  double residual_spread = 0.0;  // m, robust spread of the residuals
+  double noise = 0.0;          // m, the base map's surface noise, measured
+  int attempts = 0;            // ICP runs (1 + retries)
   bool reliable = false;
   std::string reason;          // why not reliable; empty when reliable
 };

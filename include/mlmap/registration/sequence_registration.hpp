@@ -6,17 +6,20 @@
 #pragma once
 
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include "mlmap/registration/icp.hpp"
 #include "mlmap/registration/pose_graph.hpp"
+#include "mlmap/registration/verified_icp.hpp"
 #include "mlmap/registration/voxel_hash_map.hpp"
 #include "mlmap/scan.hpp"
 
 namespace mlmap::registration {
 
 struct SequenceConfig {
-  IcpConfig icp{.initial_max_distance = 0.5};  // odometry increments are good to decimetres
+  IcpConfig icp{.initial_max_distance = 0.5};  // a lower bound: the basin sets the first gate
+  BasinConfig basin;                 // the start's error bound, verification, retries
   double source_voxel_size = 0.1;    // m, down-sampling of the scan being registered
   double map_voxel_size = 0.1;       // m, OcTree resolution of the map's key grid
   std::size_t max_points_per_voxel = 20;
@@ -34,9 +37,16 @@ struct SequenceConfig {
 };
 
 struct RefinementResult {
-  std::size_t pair_edges = 0;        // ICP edges in the last round
-  std::size_t rejected_pairs = 0;    // candidate pairs without enough overlap or convergence
+  std::size_t pair_edges = 0;        // verified ICP edges in the last round
+  std::size_t loop_edges = 0;        // ... of them between scans that are not consecutive
+  std::size_t rejected_pairs = 0;    // candidate pairs not verified (too little overlap, not explained)
   PoseGraphResult graph;             // of the last round
+  // The pose graph's poses are kept only when they lower the scans' residuals against each
+  // other (the mean truncated squared point-to-plane residual over the verified pairs, m²):
+  // refinement never makes a sequence worse than scan-to-map.
+  double residual_before = 0.0;
+  double residual_after = 0.0;
+  int rounds_applied = 0;
 };
 
 class SequenceRegistration {
@@ -44,19 +54,25 @@ class SequenceRegistration {
   explicit SequenceRegistration(const SequenceConfig& config = {});
 
   // Registers `points` (sensor frame) against the map of the scans so far, starting from
-  // the last corrected pose moved by the odometry increment, and adds it to the map. The
-  // first scan stays at its odometry pose and anchors the map. Returns the ICP result
-  // (for the first scan an empty, reliable one).
-  IcpResult addScan(const std::vector<Point>& points, const Pose& odometry);
+  // the last corrected pose moved by the odometry increment (alignVerified: wide basin,
+  // verification, retries), and adds it to the map. The first scan stays at its odometry
+  // pose and anchors the map. Returns the result (for the first scan an empty, verified one).
+  VerifiedIcp addScan(const std::vector<Point>& points, const Pose& odometry);
 
-  // Pairwise ICP between scans whose sensors are within max_pair_distance, then a pose
-  // graph with those edges and the scan-to-map chain; refines poses() in place.
+  // Pairwise ICP between scans whose sensors are within max_pair_distance (consecutive or
+  // not: loop closures), then a pose graph with the verified pairs, weighted by their
+  // normal equations, and the scan-to-map chain; refines poses() in place where that lowers
+  // the residuals.
   RefinementResult refine();
 
   const std::vector<Pose>& poses() const { return poses_; }
   const SequenceConfig& config() const { return config_; }
 
  private:
+  // The mean truncated squared point-to-plane residual of the pairs' scans at `poses`.
+  double pairResidual(const std::vector<std::pair<std::size_t, std::size_t>>& pairs, const std::vector<Pose>& poses,
+                      const std::vector<VoxelHashMap>& locals, const std::vector<double>& noise) const;
+
   SequenceConfig config_;
   VoxelHashMap map_;
   std::vector<Pose> odometry_;

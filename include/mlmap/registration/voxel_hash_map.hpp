@@ -50,6 +50,11 @@ class VoxelHashMap {
   // Every point within `radius` of `query`, in no particular order.
   std::vector<Point> within(const Point& query, double radius) const;
 
+  // The noise of the map's surfaces, m: the robust (MAD) spread of the points' distances
+  // from their voxel's plane (its normal through its points' mean), over the voxels with a
+  // normal and at least 3 points; every `stride`-th voxel; 0 when none qualifies.
+  double planeNoise(std::size_t stride = 1) const;
+
   std::vector<Point> points() const;
   std::size_t size() const { return points_.size(); }
   bool empty() const { return points_.empty(); }

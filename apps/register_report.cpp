@@ -1,0 +1,80 @@
+#include "register_report.hpp"
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "mlmap/io/atomic_file.hpp"
+
+namespace mlmap::cli {
+namespace {
+
+nlohmann::json poseJson(const Pose& pose) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) {
+    rows.push_back({pose.matrix()(r, 0), pose.matrix()(r, 1), pose.matrix()(r, 2), pose.matrix()(r, 3)});
+  }
+  return rows;
+}
+
+}  // namespace
+
+std::string verificationSummary(const registration::VerifiedIcp& result) {
+  char text[256];
+  std::snprintf(text, sizeof text, "%s: %.0f %% explained, residual spread %.2f cm (noise %.2f cm), %d ICP run%s%s",
+                result.verified        ? "verified"
+                : result.unconstrained ? "UNCONSTRAINED (a direction is free)"
+                : result.no_overlap    ? "NO OVERLAP"
+                                       : "NOT VERIFIED",
+                100.0 * result.check.explained_share,
+                100.0 * result.check.spread, 100.0 * result.noise, result.attempts, result.attempts == 1 ? "" : "s",
+                result.icp.degenerate ? ", degenerate geometry" : "");
+  return text;
+}
+
+void writeRegisterReport(const std::string& path, const std::vector<ScanReport>& scans,
+                         const registration::RefinementResult* refinement) {
+  nlohmann::json out;
+  out["schema"] = "mlmap.register.report/1";
+  out["scans"] = nlohmann::json::array();
+  for (const ScanReport& scan : scans) {
+    const registration::VerifiedIcp& r = scan.result;
+    out["scans"].push_back({{"index", scan.index},
+                            {"file", scan.file},
+                            {"points", scan.points},
+                            {"target", scan.index == 0 ? "none (first scan: anchors the map)" : "map of the scans before"},
+                            {"start", poseJson(r.start)},
+                            {"kept_start", poseJson(r.kept_start)},
+                            {"result", poseJson(r.icp.pose)},
+                            {"source_points", r.icp.source_points},
+                            {"inliers", r.icp.inliers},
+                            {"rms_residual_m", r.icp.rms_residual},
+                            {"explained_share", r.check.explained_share},
+                            {"residual_spread_m", r.check.spread},
+                            {"expected_residual_m", r.check.sigma},
+                            {"noise_m", r.noise},
+                            {"icp_runs", r.attempts},
+                            {"retries", r.attempts > 0 ? r.attempts - 1 : 0},
+                            {"iterations", r.icp.iterations},
+                            {"converged", r.icp.converged},
+                            {"degenerate", r.icp.degenerate},
+                            {"eigenvalue_ratio", r.icp.eigenvalue_ratio},
+                            {"constrained_eigenvalue_ratio", r.check.eigenvalue_ratio},
+                            {"verified", r.verified},
+                            {"unconstrained", r.unconstrained},
+                            {"no_overlap", r.no_overlap},
+                            {"reason", r.reason}});
+  }
+  if (refinement != nullptr) {
+    out["refinement"] = {{"pair_edges", refinement->pair_edges},
+                         {"loop_edges", refinement->loop_edges},
+                         {"rejected_pairs", refinement->rejected_pairs},
+                         {"graph_cost_initial", refinement->graph.initial_cost},
+                         {"graph_cost_final", refinement->graph.final_cost},
+                         {"pair_residual_before_m2", refinement->residual_before},
+                         {"pair_residual_after_m2", refinement->residual_after},
+                         {"rounds_applied", refinement->rounds_applied}};
+  }
+  io::writeAtomically(path, [&](std::ostream& stream) { stream << out.dump(1) << '\n'; });
+}
+
+}  // namespace mlmap::cli

@@ -1,0 +1,99 @@
+// ICP with a wide basin and a check of its answer. First one alignPoints run exactly as
+// asked (the caller's gate: an easy pair costs one run and one check); its result is
+// verified against the noise measured on the target (the share of source points it
+// explains, the spread of their residuals) and against the geometry (the eigenvalues of the
+// normal equations at the result: a corridor leaves its axis free, and a result there is
+// "unconstrained", not verified). Only when it is not verified does the wide basin run
+// (the first gate set from the start's error bound and the cloud's radius), then other
+// starts (yaw and translation offsets about the given one); the best-explained result is
+// kept. A first run that matches almost nothing means the clouds do not overlap: no retry.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "mlmap/registration/icp.hpp"
+#include "mlmap/registration/voxel_hash_map.hpp"
+#include "mlmap/scan.hpp"
+
+namespace mlmap::registration {
+
+struct BasinConfig {
+  // The start's error one ICP run must recover from: the first gate is
+  // max_start_translation + radius · max_start_yaw (points at the cloud's RMS range move
+  // that far), never less than IcpConfig::initial_max_distance.
+  double max_start_translation = 0.5;  // m
+  double max_start_yaw_deg = 10.0;     // deg
+  // Retries, tried in this order until one verifies: turns about the sensor (deg) and
+  // moves (m, along the target's x and y), each applied to the given start.
+  std::vector<double> retry_yaw_deg = {20.0, -20.0, 10.0, -10.0, 30.0, -30.0};
+  double retry_translation = 0.35;      // m; 0: no translation retries
+  // Verification: a source point is matched when the target has a point within the
+  // verification gate, and explained when its point-to-plane residual is within
+  // explained_sigmas · σ, σ the expected residual (√2 × the target's measured noise: both
+  // clouds carry it); the result explains the overlap when at least min_matched points
+  // match, at least min_explained_share of the matched ones are explained and the robust
+  // spread of their residuals is at most max_spread_ratio · σ. (The share of all source
+  // points follows the target's sampling of the far field, not the alignment: the lab's
+  // and the corridor's scans match 10-25 % of their points at the true pose.)
+  double noise = 0.0;                   // m, the target's noise; 0 = measured (VoxelHashMap::planeNoise)
+  double min_noise = 0.002;             // m, floor of the measured noise (centroids of dense voxels)
+  double explained_sigmas = 3.0;
+  double min_explained_share = 0.5;    // of the matched points
+  std::size_t min_matched = 100;       // IcpConfig::min_inliers
+  double max_spread_ratio = 2.0;
+  // Constrained: λ_min / λ_max of the explained points' point-to-plane normal equations
+  // (rotations scaled to metres at the cloud's RMS range) at least this. Measured on the
+  // stress benchmark (tune split): results in the lab, the symmetric room, the generated
+  // rooms and the shipped corridor 1.1e-2 to 6.7e-2; the long corridor's (all slid along
+  // it) 1.7e-3 to 5.2e-3; the tests' 24 m corridor 1e-5 to 4.4e-3, merged room maps 1.4e-2.
+  // The threshold sits between (their geometric mean).
+  double min_eigenvalue_ratio = 7.5e-3;
+  // No overlap: after the first run, fewer than this share of the source points have a
+  // neighbour within the verification gate. Measured on the stress benchmark (tune split):
+  // the first run from starts within 0.5 m / 30 deg leaves at least 13 % matched (the
+  // far field's sparse sampling keeps it low even when right); maps 60 m apart 0 %.
+  double min_matched_share = 0.02;
+  bool retry = true;                    // false: one run, verified but not retried
+};
+
+// How well a pose explains the source against the target.
+struct Verification {
+  std::size_t source_points = 0;
+  std::size_t matched = 0;     // with a neighbour (with a normal) within the verification gate
+  std::size_t explained = 0;   // ... and a residual within explained_sigmas · σ
+  double explained_share = 0.0;  // explained / source_points
+  double spread = 0.0;         // m, robust (MAD) spread of the matched points' residuals
+  double sigma = 0.0;          // m, the expected residual
+  double eigenvalue_ratio = 0.0;  // λ_min/λ_max of the explained points' normal equations
+  bool constrained = false;    // eigenvalue_ratio >= min_eigenvalue_ratio
+  bool good = false;           // explains the overlap (share and spread); see constrained
+};
+
+struct VerifiedIcp {
+  IcpResult icp;               // the kept result (its pose: source -> target)
+  Verification check;          // of the kept result
+  Pose start = Pose::Identity();  // the start given
+  Pose kept_start = Pose::Identity();  // the start the kept result ran from
+  double noise = 0.0;          // m, the target noise used
+  int attempts = 0;            // ICP runs (1: no retry)
+  double first_matched_share = 0.0;  // of the first run: source points matched within the gate
+  bool verified = false;       // explains the overlap and the geometry constrains every direction
+  bool unconstrained = false;  // explains the overlap but leaves a direction free (a corridor)
+  bool no_overlap = false;     // the first run matched almost nothing: not retried
+  std::string reason;          // why not verified; empty when verified
+};
+
+// The point-to-plane verification of `pose` (source -> target) with expected residual
+// `sigma` (m); points match within `gate` (m; the overload without: max(0.1, 10 σ)).
+Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& pose,
+                             double sigma, double gate, const BasinConfig& config = {});
+Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& pose,
+                             double sigma, const BasinConfig& config = {});
+
+// Aligns as above; `icp` sets the ICP itself (its initial_max_distance is a lower bound).
+VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& start,
+                          const IcpConfig& icp = {}, const BasinConfig& config = {});
+
+}  // namespace mlmap::registration

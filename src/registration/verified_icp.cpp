@@ -1,0 +1,233 @@
+#include "mlmap/registration/verified_icp.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <numbers>
+#include <optional>
+
+namespace mlmap::registration {
+namespace {
+
+constexpr double kMadToSigma = 1.4826;
+// A surface is level (floor, ceiling, table) when its normal is within 45 deg of vertical.
+constexpr double kLevelNormal = 0.7071;
+// The noise is measured on every this-many-th voxel of the target: a few thousand voxels
+// give the median to a few per cent.
+constexpr std::size_t kNoiseStride = 4;
+// m, the most the start's yaw error adds to the first gate: a source far from its own
+// origin (a map 60 m away) would otherwise make every search visit thousands of voxels.
+constexpr double kMaxYawReach = 1.5;
+
+double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
+
+// `start` turned by `yaw` about the source's origin (the sensor) and moved by `shift`
+// (target frame): the sensor stays where it was, only its heading changes.
+Pose offsetStart(const Pose& start, double yaw, const Eigen::Vector3d& shift) {
+  Pose pose = start;
+  pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * start.linear();
+  pose.translation() += shift;
+  return pose;
+}
+
+// Better explained: verified (explained and constrained) first, then explained, then the larger explained share; shares within
+// kShareTie of each other explain the overlap equally well (along a corridor every slide
+// does), and then the result nearer the given start wins: the start is a measurement too.
+constexpr double kShareTie = 0.02;
+double distanceFrom(const Pose& start, const Pose& pose, double radius) {
+  const Pose delta = start.inverse() * pose;
+  return delta.translation().norm() + radius * Eigen::AngleAxisd(delta.linear()).angle();
+}
+bool verifiedCheck(const Verification& check) { return check.good && check.constrained; }
+bool better(const Verification& a, double a_distance, const Verification& b, double b_distance) {
+  if (verifiedCheck(a) != verifiedCheck(b)) return verifiedCheck(a);
+  if (a.good != b.good) return a.good;
+  if (std::abs(a.explained_share - b.explained_share) > kShareTie) return a.explained_share > b.explained_share;
+  return a_distance < b_distance;
+}
+
+double cloudRadius(const std::vector<Point>& source) {
+  double radius_sq = 0.0;
+  for (const Point& point : source) radius_sq += point.squaredNorm();
+  return source.empty() ? 1.0 : std::max(1.0, std::sqrt(radius_sq / static_cast<double>(source.size())));
+}
+
+}  // namespace
+
+Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& pose,
+                             double sigma, double gate, const BasinConfig& config) {
+  Verification check;
+  check.source_points = source.size();
+  check.sigma = sigma;
+  std::vector<double> residuals(source.size(), -1.0);
+  std::vector<Eigen::Vector3d> normals(source.size());
+  const auto count = static_cast<std::int64_t>(source.size());
+#pragma omp parallel for schedule(static) if (count >= 4000)
+  for (std::int64_t k = 0; k < count; ++k) {
+    const Point moved = pose * source[static_cast<std::size_t>(k)];
+    const std::optional<Neighbour> neighbour = target.nearest(moved, gate);
+    if (!neighbour || neighbour->normal.isZero()) continue;
+    residuals[static_cast<std::size_t>(k)] = std::abs(neighbour->normal.dot(moved - neighbour->point));
+    normals[static_cast<std::size_t>(k)] = neighbour->normal;
+  }
+  // The point-to-plane normal equations of the explained points (unit weights), for an
+  // update about the sensor: rotations scaled to metres at the cloud's RMS range.
+  const double radius = cloudRadius(source);
+  const Eigen::Vector3d pivot = pose.translation();
+  Matrix6d hessian = Matrix6d::Zero();
+  std::vector<double> matched;
+  matched.reserve(residuals.size());
+  // Per kind of surface (floors and ceilings; walls): a floor matches at any yaw, so
+  // the points of each kind must be explained on their own.
+  std::array<std::vector<double>, 2> kinds;
+  for (std::size_t k = 0; k < residuals.size(); ++k) {
+    const double residual = residuals[k];
+    if (residual < 0.0) continue;
+    matched.push_back(residual);
+    kinds[std::abs(normals[k].z()) >= kLevelNormal ? 0 : 1].push_back(residual);
+    if (residual > config.explained_sigmas * sigma) continue;
+    ++check.explained;
+    Vector6d jacobian;
+    jacobian << (pose * source[k] - pivot).cross(normals[k]) / radius, normals[k];
+    hessian.selfadjointView<Eigen::Lower>().rankUpdate(jacobian);
+  }
+  if (check.explained > 0) {
+    const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(Matrix6d(hessian.selfadjointView<Eigen::Lower>()),
+                                                         Eigen::EigenvaluesOnly);
+    const double largest = solver.eigenvalues()[5];
+    check.eigenvalue_ratio = largest > 0.0 ? std::max(0.0, solver.eigenvalues()[0]) / largest : 0.0;
+  }
+  check.constrained = check.eigenvalue_ratio >= config.min_eigenvalue_ratio;
+  check.matched = matched.size();
+  check.explained_share =
+      source.empty() ? 0.0 : static_cast<double>(check.explained) / static_cast<double>(source.size());
+  if (!matched.empty()) {
+    auto middle = matched.begin() + static_cast<long>(matched.size() / 2);
+    std::nth_element(matched.begin(), middle, matched.end());
+    check.spread = kMadToSigma * *middle;
+  }
+  // Judged among the matched points: how much of a scan has a partner within the gate
+  // depends on how densely the target sampled the far field, not on the alignment.
+  check.good = check.matched >= config.min_matched &&
+               static_cast<double>(check.explained) >= config.min_explained_share * static_cast<double>(check.matched) &&
+               check.spread <= config.max_spread_ratio * sigma;
+  for (std::vector<double>& kind : kinds) {
+    if (kind.size() < config.min_matched) continue;
+    const double bound = config.explained_sigmas * sigma;
+    const auto explained = std::count_if(kind.begin(), kind.end(), [&](double r) { return r <= bound; });
+    auto middle = kind.begin() + static_cast<long>(kind.size() / 2);
+    std::nth_element(kind.begin(), middle, kind.end());
+    const double spread = kMadToSigma * *middle;
+    check.spread = std::max(check.spread, spread);
+    check.good = check.good &&
+                 static_cast<double>(explained) >= config.min_explained_share * static_cast<double>(kind.size()) &&
+                 spread <= config.max_spread_ratio * sigma;
+  }
+  return check;
+}
+
+Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& pose,
+                             double sigma, const BasinConfig& config) {
+  return verifyAlignment(source, target, pose, sigma, std::max(0.1, 10.0 * sigma), config);
+}
+
+VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& start,
+                          const IcpConfig& icp, const BasinConfig& config) {
+  VerifiedIcp out;
+  out.start = out.kept_start = start;
+  out.icp.pose = start;
+  out.icp.source_points = source.size();
+  if (source.empty() || target.empty()) {
+    out.reason = source.empty() ? "no source points" : "empty target";
+    return out;
+  }
+  // The expected residual: both clouds carry the measured noise.
+  out.noise = config.noise > 0.0 ? config.noise : std::max(config.min_noise, target.planeNoise(kNoiseStride));
+  const double sigma = std::sqrt(2.0) * out.noise;
+  // The verification gate reaches past a misalignment's residuals (so their spread shows)
+  // but not past the ICP's own final gate.
+  const double gate = std::max(icp.min_max_distance, 10.0 * sigma);
+  const double radius = cloudRadius(source);
+
+  bool have = false;
+  double kept_distance = 0.0;
+  const auto attempt = [&](const Pose& from, const IcpConfig& run) {
+    const IcpResult result = alignPoints(source, target, from, run);
+    ++out.attempts;
+    const Verification check = verifyAlignment(source, target, result.pose, sigma, gate, config);
+    const double distance = distanceFrom(start, result.pose, radius);
+    // A later run replaces the first only when it is verified: among results that are
+    // not, the share of explained points misleads (a scan slid onto the target's sensor
+    // position explains more of itself: the target is densest there), and the first run
+    // is the plain ICP's answer.
+    if (!have || (verifiedCheck(check) && better(check, distance, out.check, kept_distance))) {
+      kept_distance = distance;
+      out.icp = result;
+      out.check = check;
+      out.kept_start = from;
+      have = true;
+    }
+    return check;
+  };
+
+  // 1. One run as asked: most pairs end here, at the cost of the plain ICP and one check.
+  const Verification first = attempt(start, icp);
+  out.first_matched_share =
+      static_cast<double>(first.matched) / static_cast<double>(std::max<std::size_t>(1, first.source_points));
+  // A start within the basin of clouds that overlap leaves much of the source near the
+  // target after one run; almost nothing near it means there is no overlap to find.
+  out.no_overlap = out.first_matched_share < config.min_matched_share;
+  // Explained but unconstrained: the free direction stays where the start put it (ICP
+  // leaves it alone), and no other start can fix what the geometry does not measure.
+  const bool settled = verifiedCheck(first) || first.good || out.no_overlap;
+  if (!settled && config.retry) {
+    // 2. The wide basin from the same start, then other starts about it.
+    IcpConfig wide = icp;
+    wide.initial_max_distance = std::max(
+        icp.initial_max_distance,
+        config.max_start_translation + std::min(kMaxYawReach, radius * radians(config.max_start_yaw_deg)));
+    std::vector<Pose> starts{start};
+    for (const double yaw : config.retry_yaw_deg) {
+      starts.push_back(offsetStart(start, radians(yaw), Eigen::Vector3d::Zero()));
+    }
+    if (config.retry_translation > 0.0) {
+      const double t = config.retry_translation;
+      for (const Eigen::Vector3d& shift : {Eigen::Vector3d(t, 0, 0), Eigen::Vector3d(-t, 0, 0),
+                                          Eigen::Vector3d(0, t, 0), Eigen::Vector3d(0, -t, 0)}) {
+        starts.push_back(offsetStart(start, 0.0, shift));
+      }
+    }
+    for (const Pose& from : starts) {
+      if (verifiedCheck(attempt(from, wide))) break;
+    }
+  }
+  out.verified = verifiedCheck(out.check);
+  out.unconstrained = out.check.good && !out.check.constrained;
+  char text[240];
+  if (out.no_overlap) {
+    std::snprintf(text, sizeof text,
+                  "no overlap: only %.1f %% of the points lie within %.0f cm of the target after the first run",
+                  100.0 * out.first_matched_share, 100.0 * gate);
+    out.reason = text;
+  } else if (out.unconstrained) {
+    std::snprintf(text, sizeof text,
+                  "unconstrained: the result explains %.0f %% of the points but the geometry leaves a direction "
+                  "free (eigenvalue ratio %.1e < %.1e)",
+                  100.0 * out.check.explained_share, out.check.eigenvalue_ratio, config.min_eigenvalue_ratio);
+    out.reason = text;
+  } else if (!out.verified) {
+    std::snprintf(text, sizeof text,
+                  "no start of %d gave a result that explains the overlap: best %.0f %% of the points within "
+                  "%.1f cm, residual spread %.2f cm (expected %.2f cm)",
+                  out.attempts, 100.0 * out.check.explained_share, 100.0 * config.explained_sigmas * sigma,
+                  100.0 * out.check.spread, 100.0 * sigma);
+    out.reason = text;
+  }
+  return out;
+}
+
+}  // namespace mlmap::registration
