@@ -144,7 +144,7 @@ TEST_CASE("alignVerified: a wrong pose is not verified, and says why") {
   CHECK(result.attempts == 1);
 }
 
-TEST_CASE("alignVerified: a bare corridor is unconstrained, not verified; clouds apart are no overlap") {
+TEST_CASE("alignVerified: a bare corridor is unconstrained, not verified, and clouds apart are no overlap") {
   // 30 m of bare corridor: nothing fixes the position along it. Before the eigenvalue
   // check such results were called verified wherever ICP left them.
   const Pair corridor = simulatedPair(R"({
