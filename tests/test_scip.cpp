@@ -189,6 +189,21 @@ TEST_CASE("SCIP client: MD stream, values straddling lines, drops and resynchron
   CHECK_THROWS_AS(client.nextScan(), ScipError);  // nothing more: timeout
 }
 
+TEST_CASE("SCIP client: QT during a stream skips a data line that starts with \"QT\"") {
+  FakeLaser laser;
+  ScipClient client(*laser.client, std::chrono::milliseconds(300));
+  // 137472 encodes as "QT0": the frame's first data line starts with QT's echo.
+  std::vector<std::uint32_t> values = ramp(1081);
+  values[0] = 137472;
+  REQUIRE(scipEncode(values[0], 3) == "QT0");
+  laser.answer(frame("MD0000108001000", "00"));
+  laser.answer(scanFrame("MD0000108001000", 0x000010, values));
+  laser.answer(frame("QT", "00"));
+  client.startScans(0, 1080, 1, true, 0);
+  CHECK_NOTHROW(client.stop());  // was: "QT...: bad status line" (a data line taken for the echo)
+  CHECK(laser.received() == "MD0000108001000\nQT\n");
+}
+
 TEST_CASE("SCIP client: MS (2-character) with clusters, GD single scan") {
   FakeLaser laser;
   ScipClient client(*laser.client, std::chrono::milliseconds(300));
