@@ -47,11 +47,13 @@ class RecordedDevice : public Transport {
 TEST_CASE("fuzz regression scip_stream: a stream of nothing but acknowledgements") {
   // Found by fuzz_scip_stream: nextScan skips status-00 frames (MD's acknowledgement)
   // without counting an error, so after max_drops + 1 of them it rethrew an empty
-  // std::optional — a crash. Minimised input (MS, cluster 4):
-  const std::string replies =
-      "MS0000009904000\n00\n\nMS00000099040M\n00\n\nMS00000099040\n00\n\nMS00000099040\n00\n\n"
-      "MS00000099040\n00\n\nMS00000099040\n00\n\nMS00000099040\n00\n\nMS000000990401\n00\n\n"
-      "MS00000099040\n00\n\nMS00000099040\n00\n\n\x01";
+  // std::optional — a crash. The minimised input (MS, cluster 4) had echoes cut to their
+  // first 13 characters or ending in stray characters; since an echo must carry the
+  // remaining-scan count (a data line that merely starts like one is none), they are
+  // written whole here, ten acknowledgements in a row:
+  std::string replies;
+  for (int k = 0; k < 10; ++k) replies += "MS0000009904000\n00\n\n";
+  replies += "\x01";
   RecordedDevice device(replies);
   ScipClient laser(device, std::chrono::milliseconds(0));
   laser.startScans(0, 99, 4, false);
