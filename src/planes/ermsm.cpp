@@ -14,6 +14,7 @@
 
 #include "candidates.hpp"
 #include "fill_vector.hpp"
+#include "median.hpp"
 #include "mlmap/planes/block_grid.hpp"
 #include "mlmap/planes/classify.hpp"
 #include "mlmap/planes/direction_vectors.hpp"
@@ -65,9 +66,7 @@ double rangeNoise(const MLMap& map) {
     }
   }
   if (variances.empty()) return 0.01;
-  auto middle = variances.begin() + static_cast<long>(variances.size() / 2);
-  std::nth_element(variances.begin(), middle, variances.end());
-  return std::sqrt(std::max(0.0F, *middle));
+  return std::sqrt(std::max(0.0F, medianOf(variances)));
 }
 
 // Whether the map's blocks keep their points' moments (format 3 and later).
@@ -206,7 +205,7 @@ bool Detector::noiseExplainsSpread(const CandidatePlane& plane, const std::vecto
   return !spreadExceeds(grid_, directions_, strict, plane, limit, patch_threads_);
 }
 
-// A level plane's blocks must lie on it: the median distance of their points' means
+// A level plane's blocks must lie on it: their median distance (PlaneBlock::point)
 // from it at most ε / 3. Noise of σ ≤ ε / 3 puts it at 0.67 σ or less; a heap of clutter
 // filling the slab ±ε round the plane at ε / 2. Direction windows widened over a heap see
 // it level on average, so the spread rule alone no longer refuses one. A median, so that

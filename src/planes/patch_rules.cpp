@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "id_set.hpp"
+#include "median.hpp"
 #include "pca_sums.hpp"
 
 namespace mlmap {
@@ -90,9 +91,7 @@ double medianDistance(const BlockGrid& grid, const std::vector<std::uint32_t>& i
   std::vector<float> distances;
   distances.reserve(ids.size());
   for (const std::uint32_t id : ids) distances.push_back(std::abs(plane.normal.dot(grid.blocks()[id].point - plane.point)));
-  auto middle = distances.begin() + static_cast<long>(distances.size() / 2);
-  std::nth_element(distances.begin(), middle, distances.end());
-  return *middle;
+  return medianOf(distances);
 }
 
 double noiseSpread(const std::vector<float>& tilts, const std::vector<std::uint32_t>& ids, double kappa_rad) {
@@ -102,9 +101,7 @@ double noiseSpread(const std::vector<float>& tilts, const std::vector<std::uint3
     if (std::isfinite(tilts[id])) known.push_back(std::min(tilts[id], static_cast<float>(kappa_rad)));
   }
   if (known.empty()) return 0.0;
-  auto middle = known.begin() + static_cast<long>(known.size() / 2);
-  std::nth_element(known.begin(), middle, known.end());
-  return *middle * std::sqrt(std::numbers::pi / 2.0) * 180.0 / std::numbers::pi;
+  return medianOf(known) * std::sqrt(std::numbers::pi / 2.0) * 180.0 / std::numbers::pi;
 }
 
 bool spreadExceeds(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,

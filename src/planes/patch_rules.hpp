@@ -45,8 +45,9 @@ double noiseSpread(const std::vector<float>& tilts, const std::vector<std::uint3
 // noise's, the two adding as independent errors do (in squares).
 inline double spreadLimit(double max_deg, double noise_deg) { return std::hypot(max_deg, noise_deg); }
 
-// The median distance of the blocks `ids` (their points' mean) from the plane, m: how
-// thick they lie round it, robust to the few a neighbouring object pulls away.
+// The median distance of the blocks `ids` (PlaneBlock::point: across at their points'
+// mean, up at h) from the plane, m: how thick they lie round it, robust to the few a
+// neighbouring object pulls away.
 double medianDistance(const BlockGrid& grid, const std::vector<std::uint32_t>& ids, const CandidatePlane& plane);
 
 // A patch one cell wide is no surface: it is the fringe of a wall standing on a cell

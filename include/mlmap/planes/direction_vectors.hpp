@@ -19,8 +19,9 @@ namespace mlmap {
 // leave a direction too uncertain for the seeds' agreement test: on 3DTK's corridor
 // ceiling at 5 cm cells (blocks 5.5 cm RMS about its plane, 1-2 points each) the
 // directions of r = 2 lie a median 11 deg off its normal, and the ceiling was no patch.
-// Such a block's window widens, a cell at a time up to max_radius, until the normal's
-// standard error, from the window's own residual and spread, is at most max_tilt.
+// Such a level block's window widens, a cell at a time up to max_radius, until the
+// normal's standard error, from the window's own residual and spread, is at most
+// max_tilt (walls' windows and windows too small to measure their scatter do not).
 struct DirectionConfig {
   int radius = 2;                 // cells, Chebyshev radius r of the neighbourhood
   float height_tolerance = 0.08F; // m, horizontal neighbours must lie this close in height

@@ -17,7 +17,9 @@ struct ErmsmConfig {
   // cells: a level block's direction window widens up to this where r cells leave its
   // normal uncertain (standard error over θ / 3.5: noisy or sparse surfaces); 0 = 2 r
   int max_radius = 0;
-  double epsilon = 0.0;           // m, max block-plane distance ε; 0 = max(cell size, min(3 σ, 0.05))
+  // m, max block-plane distance ε; 0 = max(3 σ, min(cell size, 0.05)) (maps without point
+  // moments: max(cell size, min(3 σ, 0.05)))
+  double epsilon = 0.0;
   double noise = 0.0;             // m, σ of the points' range noise; 0 = the median of the map's vertical blocks' σ
   // m: consecutive blocks of a cell closer than this are one eRMSM block (a wall's stack
   // between scan lines in cells finer than their spacing); a stack no deeper than
