@@ -53,37 +53,40 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config) {
     if (std::abs(planes[k].normal.z()) >= cos_horizontal) horizontal.push_back(k);
   }
   // The floor: the largest horizontal patch among the lowest ones; the ceiling: the
-  // largest one a storey above it.
-  std::optional<double> floor_z;
-  std::optional<double> ceiling_z;
+  // largest one a storey above it. Heights are taken from the floor's plane, not as z:
+  // real scans are seldom level (3DTK's floor 4° off in its registered frame, PCL's
+  // room_scan2 2°), and across a room of 5 m two patches of one such floor differ by
+  // 8-35 cm in z at their centroids.
+  const Plane* floor = nullptr;
+  const Plane* ceiling = nullptr;
   double lowest = std::numeric_limits<double>::infinity();
   for (const std::size_t k : horizontal) lowest = std::min(lowest, planes[k].centroid.z());
-  double floor_area = 0.0;
   for (const std::size_t k : horizontal) {
-    if (planes[k].centroid.z() <= lowest + config.floor_search && planes[k].area > floor_area) {
-      floor_area = planes[k].area;
-      floor_z = planes[k].centroid.z();
+    if (planes[k].centroid.z() <= lowest + config.floor_search && (floor == nullptr || planes[k].area > floor->area)) {
+      floor = &planes[k];
     }
   }
-  double ceiling_area = 0.0;
+  // m: how far `point` lies above the floor's plane (horizontal normals point up).
+  auto aboveFloor = [&](const Eigen::Vector3d& point) { return floor->normal.dot(point) + floor->offset; };
   for (const std::size_t k : horizontal) {
-    if (floor_z && planes[k].centroid.z() >= *floor_z + config.ceiling_min_height &&
-        planes[k].area > ceiling_area) {
-      ceiling_area = planes[k].area;
-      ceiling_z = planes[k].centroid.z();
+    if (floor != nullptr && aboveFloor(planes[k].centroid) >= config.ceiling_min_height &&
+        (ceiling == nullptr || planes[k].area > ceiling->area)) {
+      ceiling = &planes[k];
     }
   }
-  auto near = [&](const std::optional<double>& level, double z) {
-    return level && std::abs(z - *level) < config.level_tolerance;
+  auto near = [&](const Plane* level, const Eigen::Vector3d& point) {
+    return level != nullptr && std::abs(level->normal.dot(point) + level->offset) < config.level_tolerance;
   };
+  // The labels are written after the search: `floor` and `ceiling` point into `planes`.
+  std::vector<PlaneClass> labels(planes.size(), PlaneClass::Other);
   // Horizontal patches first: risers and steps refer to them.
   for (const std::size_t k : horizontal) {
-    Plane& plane = planes[k];
+    const Plane& plane = planes[k];
     const double z = plane.centroid.z();
-    if (near(floor_z, z)) {
-      plane.label = PlaneClass::Floor;
-    } else if (near(ceiling_z, z)) {
-      plane.label = PlaneClass::Ceiling;
+    if (near(floor, plane.centroid)) {
+      labels[k] = PlaneClass::Floor;
+    } else if (near(ceiling, plane.centroid)) {
+      labels[k] = PlaneClass::Ceiling;
     } else {
       bool step = false;
       for (const std::size_t other : horizontal) {
@@ -93,16 +96,16 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config) {
           step = true;
         }
       }
-      const double above_floor = floor_z ? z - *floor_z : 0.0;
-      if (step && (!ceiling_z || z < *ceiling_z - config.riser_max)) {
-        plane.label = PlaneClass::Step;
-      } else if (floor_z && above_floor >= config.table_min_height && above_floor <= config.table_max_height) {
-        plane.label = PlaneClass::Table;
-      } else {
-        plane.label = PlaneClass::Other;
+      const double above_floor = floor != nullptr ? aboveFloor(plane.centroid) : 0.0;
+      const bool below_ceiling = ceiling == nullptr || ceiling->normal.dot(plane.centroid) + ceiling->offset < -config.riser_max;
+      if (step && below_ceiling) {
+        labels[k] = PlaneClass::Step;
+      } else if (floor != nullptr && above_floor >= config.table_min_height && above_floor <= config.table_max_height) {
+        labels[k] = PlaneClass::Table;
       }
     }
   }
+  for (const std::size_t k : horizontal) planes[k].label = labels[k];
   for (std::size_t k = 0; k < planes.size(); ++k) {
     Plane& plane = planes[k];
     if (std::abs(plane.normal.z()) >= cos_horizontal) continue;
