@@ -39,9 +39,12 @@ int runPlanes(const PlanesArguments& arguments, bool quiet) {
               stats.direction_seconds + stats.detection_seconds, stats.direction_seconds, stats.detection_seconds);
   // The parameters the run used, resolved ones (ε, σ) included: the JSON has them all.
   const ErmsmConfig& used = detection.config;
-  std::printf("  parameters: r %d cells, ε %.3f m, σ %.4f m, κ %g°, θ %g°, p_t %g, s_m %g m², "
+  // σ measured on a first pass's planes says what the build assumed.
+  char assumed[80] = "";
+  if (stats.prior_noise > 0.0) std::snprintf(assumed, sizeof assumed, " (measured; %.4f m assumed)", stats.prior_noise);
+  std::printf("  parameters: r %d cells, ε %.3f m, σ %.4f m%s, κ %g°, θ %g°, p_t %g, s_m %g m², "
               "Max_cp %d, seed %llu\n",
-              used.radius, used.epsilon, used.noise, used.kappa_deg, used.theta_deg, used.min_probability,
+              used.radius, used.epsilon, used.noise, assumed, used.kappa_deg, used.theta_deg, used.min_probability,
               used.min_area, used.max_candidates, static_cast<unsigned long long>(used.seed));
   const ErmsmStageSeconds& stage = stats.stages;
   std::printf("  stages (s): noise %.3f, blocks %.3f, directions %.3f, index %.3f, search %.3f, patches %.3f, "

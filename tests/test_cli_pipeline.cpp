@@ -73,8 +73,10 @@ TEST_CASE("CLI: planes -o keeps the planes in the map, and export writes every f
   // The summary says which parameters the run used, the resolved ε and σ among them.
   const auto printed = runCli("--quiet planes " + rooms.map.string() + " --seed 7 --kappa 20");
   REQUIRE_MESSAGE(printed.exit_code == 0, printed.output);
-  // ε resolved to max(3 σ, min(cell, 5 cm)): these rooms carry 3 cm of range noise.
-  CHECK_MESSAGE(printed.output.find("parameters: r 2 cells, ε 0.090 m, σ 0.0300 m") != std::string::npos, printed.output);
+  // The build assumed 3 cm of range noise (points from a file), ε = 3 σ; the planes then
+  // measure the points' own (0.5 cm here) and say so. ε is not narrowed by it.
+  CHECK_MESSAGE(printed.output.find("parameters: r 2 cells, ε 0.090 m, σ 0.00") != std::string::npos, printed.output);
+  CHECK_MESSAGE(printed.output.find(" m (measured; 0.0300 m assumed)") != std::string::npos, printed.output);
   CHECK_MESSAGE(printed.output.find("κ 20°, θ 15°") != std::string::npos, printed.output);
   CHECK_MESSAGE(printed.output.find("seed 7\n") != std::string::npos, printed.output);
 

@@ -22,6 +22,7 @@
 #include "patch_rules.hpp"
 #include "patch_set.hpp"
 #include "plane_scorer.hpp"
+#include "surface_noise.hpp"
 #include "unseen_gaps.hpp"
 
 #ifdef _OPENMP
@@ -401,9 +402,20 @@ PatchSet Detector::run(ErmsmStats& stats) {
   return std::move(patches_);
 }
 
-}  // namespace
+// Block heights average several points, so their scatter stays below the points':
+// 3 σ. Real surfaces are not that flat over metres: on scans made elsewhere the
+// points' RMS to their own plane reaches 2.1 cm (3DTK's floor), 2.6 cm (its ceiling),
+// 2.3 cm (a wall of OctoMap's fr079): ε is at least min(cell, 5 cm), about two of
+// those. Where blocks sit at cell centres (maps without point moments, format 2 and
+// before), never less than a cell: a wall on a cell boundary has blocks half a cell
+// either side of it.
+double defaultEpsilon(const MLMap& map, double noise) {
+  return hasPointStats(map) ? std::max(3.0 * noise, std::min(map.cellSize(), 0.05))
+                            : std::max(map.cellSize(), std::min(3.0 * noise, 0.05));
+}
 
-PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
+// One detection with σ resolved (config.noise > 0).
+PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config) {
   const auto start = Clock::now();
   auto stage_start = start;
   PlaneDetection detection;
@@ -416,19 +428,7 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   };
   ErmsmConfig& config = detection.config;
   config = input_config;
-  if (config.noise <= 0.0) config.noise = rangeNoise(map);
-  // Block heights average several points, so their scatter stays below the points':
-  // 3 σ. Real surfaces are not that flat over metres: on scans made elsewhere the
-  // points' RMS to their own plane reaches 2.1 cm (3DTK's floor), 2.6 cm (its ceiling),
-  // 2.3 cm (a wall of OctoMap's fr079): ε is at least min(cell, 5 cm), about two of
-  // those. Where blocks sit at cell centres (maps without point moments, format 2 and
-  // before), never less than a cell: a wall on a cell boundary has blocks half a cell
-  // either side of it.
-  if (config.epsilon <= 0.0) {
-    const bool at_points = hasPointStats(map);
-    config.epsilon = at_points ? std::max(3.0 * config.noise, std::min(map.cellSize(), 0.05))
-                               : std::max(map.cellSize(), std::min(3.0 * config.noise, 0.05));
-  }
+  if (config.epsilon <= 0.0) config.epsilon = defaultEpsilon(map, config.noise);
   // The blocks' old labels need no clearing: the write-back at the end labels every
   // map block (each lies in one eRMSM block), 0 where no patch took it.
   stats.stages.noise = stage();
@@ -484,6 +484,45 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   stats.stages.labels = stage();
   // Everything after the direction vectors, the labels written back included.
   stats.detection_seconds = secondsSince(detection_start);
+  return detection;
+}
+
+}  // namespace
+
+// σ sets ε (3 σ), the level band (5 σ) and the rung variance. Without --noise it is the
+// blocks' own variance first: what the build was told about its measurements (3 cm for
+// points from a file, whatever the scanner), not what they are. Where the blocks keep
+// their points, the planes of that first pass then measure it: the median RMS distance
+// of a block's points from its patch (surface_noise.hpp), about the noise the planes
+// must tolerate, surface waviness and registration included. On the real scans of
+// bench/real_data.py at 5 cm cells, against 3 cm assumed: 3DTK 2.3 cm, OctoMap's fr079
+// 0.9, Bobkov's room 1.9, PCL's office1 1.2 and room scans 1.2-1.3, plane_seg's stairs
+// 1.0 and 0.8. The planes are detected again with it unless it lies within 25 % of the
+// first σ (what a second pass could change there is within the estimate's own spread
+// between cell sizes).
+PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
+  ErmsmConfig config = input_config;
+  const bool measure = config.noise <= 0.0 && hasPointStats(map);
+  const auto start = Clock::now();
+  if (config.noise <= 0.0) config.noise = rangeNoise(map);
+  PlaneDetection detection = detectOnce(map, config);
+  if (!measure) return detection;
+  const std::optional<double> measured = surfaceNoise(map, detection.planes);
+  if (!measured || *measured <= 0.0 || std::abs(std::log(*measured / config.noise)) <= std::log(1.25)) return detection;
+  const double first_pass_seconds = secondsSince(start);
+  ErmsmConfig again = input_config;
+  again.noise = *measured;
+  // ε is widened by the measurement, never narrowed: a median over all blocks speaks for
+  // the surfaces seen best, and a sparse, far one (3DTK's ceiling at 5 cm cells; the 4 cm
+  // ceiling over a 1 cm floor of tests/test_planes_noisy.cpp) is lost with ε from the
+  // floor's noise. Narrowing it found plane_seg's first stair tread at 5 cm cells and
+  // lost room walls of PCL's room_scan1 and room_scan2.
+  if (again.epsilon <= 0.0) again.epsilon = defaultEpsilon(map, std::max(config.noise, *measured));
+  detection = detectOnce(map, again);
+  detection.stats.prior_noise = config.noise;
+  // The first pass was the noise estimate.
+  detection.stats.stages.noise += first_pass_seconds;
+  detection.stats.direction_seconds += first_pass_seconds;
   return detection;
 }
 

@@ -20,7 +20,9 @@ struct ErmsmConfig {
   // m, max block-plane distance ε; 0 = max(3 σ, min(cell size, 0.05)) (maps without point
   // moments: max(cell size, min(3 σ, 0.05)))
   double epsilon = 0.0;
-  double noise = 0.0;             // m, σ of the points' range noise; 0 = the median of the map's vertical blocks' σ
+  // m, σ of the points' range noise; 0 = measured: the median of the map's vertical
+  // blocks' σ, then, where the blocks keep their points, about the planes found with it
+  double noise = 0.0;
   // m: consecutive blocks of a cell closer than this are one eRMSM block (a wall's stack
   // between scan lines in cells finer than their spacing); a stack no deeper than
   // max(cell size, 5 σ) counts as level.
@@ -80,6 +82,9 @@ struct ErmsmStats {
   std::size_t scored = 0;              // fully scored (the rest re-found a listed plane)
   std::size_t accepted = 0;            // accepted eRMSM planes (before the patch split)
   std::size_t labelled_blocks = 0;
+  // m: where σ was measured on a first pass's planes (see detectPlanes), that pass's σ;
+  // 0 where one pass sufficed
+  double prior_noise = 0.0;
   double direction_seconds = 0.0;   // noise estimate, eRMSM blocks and direction vectors
   double detection_seconds = 0.0;   // Algorithm 1 with refits, patch split, merges, classes, labels
   ErmsmStageSeconds stages;         // both, split further
@@ -92,7 +97,10 @@ struct PlaneDetection {
 };
 
 // Detects the planes of `map` and writes each block's patch id into Block::plane
-// (0 for none; labels from an earlier run are cleared first).
+// (0 for none; labels from an earlier run are cleared first). Without config.noise and
+// where the blocks keep their points, σ is measured on the planes a first pass finds
+// and, if it differs from the blocks' own by more than 25 %, the planes are detected
+// again with it (ErmsmStats::prior_noise says so).
 PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& config = {});
 
 }  // namespace mlmap
