@@ -1,6 +1,7 @@
 // mlmap label: every input point, in input order, in the world frame, with the patch
 // id of the block that collected it ("x y z id", −1 for none), refined point by point
 // against the patches' planes unless --block-labels.
+#include <algorithm>
 #include <cstdio>
 #include <limits>
 
@@ -54,9 +55,13 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
       },
       [&](std::size_t file) { progress.update(file + 1); });
   progress.finish();
+  // A patch's tolerance is capped by the sensor's noise: where the planes measured σ
+  // (a median over all their blocks, below the noisier surfaces' own), by the larger of
+  // that and what the build assumed.
+  const double cap = std::max(map.planes()->config.noise, map.planes()->stats.prior_noise);
   if (!arguments.block_labels)
     refinePointLabels(map.blocks(), map.planes()->planes, labelled.points, labelled.labels,
-                      PointLabelRefinement{.noise = map.planes()->config.noise,
+                      PointLabelRefinement{.noise = cap,
                                            .band = map.planes()->config.epsilon + 0.5 * map.blocks().cellSize()},
                       // Without a pose file a scan's frame may be the world's, not its
                       // scanner's: then where its beams started is unknown.

@@ -77,7 +77,7 @@ void addPlanesCommand(CLI::App& app, Context& context) {
       ->capture_default_str();
   addNumber(command, "--epsilon", config.epsilon,
             "ε: max block-plane distance, m (default: max(3 σ, min(cell size, 0.05)); maps without point moments: max(cell size, min(3 σ, 0.05)))", 0.0, Bound::Closed, 10.0);
-  addNumber(command, "--noise", config.noise, "σ: range noise of the map's points, m (default: from its vertical blocks)",
+  addNumber(command, "--noise", config.noise, "σ: range noise of the map's points, m (default: the blocks' own, then measured on the planes found with it)",
             0.0, Bound::Closed, 10.0);
   addNumber(command, "--stack-gap", config.stack_gap, "A cell's blocks closer than this are one eRMSM block, m", 0.0,
             Bound::Closed)

@@ -96,6 +96,13 @@ TEST_CASE("PlanesJson: an export reads back to the same planes") {
   CHECK(back.stats.candidates == detection.stats.candidates);
   CHECK(back.config.kappa_deg == detection.config.kappa_deg);
   CHECK(back.config.seed == detection.config.seed);
+  // σ the build assumed, where the planes measured theirs: `mlmap label` caps a patch's
+  // tolerance by the larger of the two.
+  PlaneDetection measured = detection;
+  measured.stats.prior_noise = 0.03;
+  CHECK(io::parsePlanesJson(io::planesJson(map, measured, "room.mlmap"), "room.json").stats.prior_noise ==
+        doctest::Approx(0.03));
+  CHECK(back.stats.prior_noise == doctest::Approx(detection.stats.prior_noise));
 }
 
 TEST_CASE("PlanesJson: a plane per line, outline corners and centroids to the micrometre") {

@@ -183,6 +183,8 @@ PlaneDetection parsePlanesJson(std::string_view text, const std::string& name) {
   stats.labelled_blocks = static_cast<std::size_t>(reader.integer(run, "detection", "labelled_blocks", 0, kCountMax));
   stats.blocks_with_direction =
       static_cast<std::size_t>(reader.integer(run, "detection", "blocks_with_direction", 0, kCountMax));
+  const json& parameters = reader.member(document, "top level", "parameters");
+  if (parameters.contains("assumed_noise")) stats.prior_noise = reader.number(parameters, "parameters", "assumed_noise");
   const json& timings = reader.member(document, "top level", "timings");
   stats.direction_seconds = reader.number(timings, "timings", "direction_vectors_s");
   stats.detection_seconds = reader.number(timings, "timings", "detection_s");

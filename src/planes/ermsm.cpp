@@ -415,7 +415,9 @@ double defaultEpsilon(const MLMap& map, double noise) {
 }
 
 // One detection with σ resolved (config.noise > 0).
-PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config) {
+// `block_noise`: the σ the blocks' variances were fused with (rangeNoise), which the rung
+// test compares them in.
+PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config, double block_noise) {
   const auto start = Clock::now();
   auto stage_start = start;
   PlaneDetection detection;
@@ -433,12 +435,13 @@ PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config) {
   // map block (each lies in one eRMSM block), 0 where no patch took it.
   stats.stages.noise = stage();
   // A level rung is fused from a few points (under ten): its variance is a good part
-  // of one point's σ², a table top's far below it.
+  // of one point's σ², a table top's far below it; σ the build's, in which the blocks'
+  // variances are, not the one measured on the planes.
   const BlockGrid grid(map, BlockGridConfig{.stack_gap = config.stack_gap,
                                             .level_band = 5.0 * config.noise,
                                             .ladder_gap = config.ladder_gap,
                                             .ladder_blocks = config.ladder_blocks,
-                                            .rung_variance = 0.1 * config.noise * config.noise});
+                                            .rung_variance = 0.1 * block_noise * block_noise});
   stats.stages.grid = stage();
   DirectionConfig direction_config;
   direction_config.radius = config.radius;
@@ -504,8 +507,9 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   ErmsmConfig config = input_config;
   const bool measure = config.noise <= 0.0 && hasPointStats(map);
   const auto start = Clock::now();
-  if (config.noise <= 0.0) config.noise = rangeNoise(map);
-  PlaneDetection detection = detectOnce(map, config);
+  const double block_noise = rangeNoise(map);
+  if (config.noise <= 0.0) config.noise = block_noise;
+  PlaneDetection detection = detectOnce(map, config, block_noise);
   if (!measure) return detection;
   const std::optional<double> measured = surfaceNoise(map, detection.planes);
   if (!measured || *measured <= 0.0 || std::abs(std::log(*measured / config.noise)) <= std::log(1.25)) return detection;
@@ -518,7 +522,7 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   // floor's noise. Narrowing it found plane_seg's first stair tread at 5 cm cells and
   // lost room walls of PCL's room_scan1 and room_scan2.
   if (again.epsilon <= 0.0) again.epsilon = defaultEpsilon(map, std::max(config.noise, *measured));
-  detection = detectOnce(map, again);
+  detection = detectOnce(map, again, block_noise);
   detection.stats.prior_noise = config.noise;
   // The first pass was the noise estimate.
   detection.stats.stages.noise += first_pass_seconds;
