@@ -123,7 +123,7 @@ TEST_CASE("alignVerified: far is not degenerate") {
 
 TEST_CASE("alignVerified: a wrong pose is not verified, and says why") {
   const Pair pair = simulatedPair(kRoomJson);
-  const double sigma = std::sqrt(2.0) * pair.target.planeNoise();
+  const double sigma = std::hypot(pair.target.surfaceNoise(), cloudNoise(pair.source, 0.1, 0.002));
   const Verification right = verifyAlignment(pair.source, pair.target, pair.true_pose, sigma);
   CHECK(right.good);
   CHECK(right.constrained);
