@@ -87,21 +87,20 @@ RefinementResult SequenceRegistration::refine() {
   pair_basin.max_start_translation = 0.0;
   pair_basin.max_start_yaw_deg = 0.0;
   // Each scan alone in its sensor frame: the targets of the pairwise ICP, with its noise.
-  // Each scan's noise as a target (its local map) and as a source (its down-sampled
-  // points), measured once here rather than in every pair.
+  // Each scan's noise, measured once here rather than in every pair, on its local map; as a
+  // source it counts the same (measured on their own, the simulated lab's down-sampled
+  // scans show 0.40-0.55 cm against 0.36-0.45 cm for the map, and cost a voxel hash each).
   std::vector<VoxelHashMap> locals;
   std::vector<double> noise;
-  std::vector<double> source_noise;
-  for (std::size_t k = 0; k < dense_.size(); ++k) {
+  for (const std::vector<Point>& dense : dense_) {
     locals.emplace_back(config_.map_voxel_size, config_.max_points_per_voxel);
-    locals.back().addPoints(dense_[k]);
+    locals.back().addPoints(dense);
     locals.back().estimateNormals(config_.normals);
     noise.push_back(config_.basin.noise > 0.0 ? config_.basin.noise
                                               : std::max(config_.basin.min_noise, locals.back().surfaceNoise()));
-    source_noise.push_back(config_.basin.source_noise > 0.0
-                               ? config_.basin.source_noise
-                               : cloudNoise(sources_[k], config_.map_voxel_size, config_.basin.min_noise));
   }
+  const std::vector<double>& source_noise =
+      config_.basin.source_noise > 0.0 ? std::vector<double>(noise.size(), config_.basin.source_noise) : noise;
   for (int round = 0; round < config_.refinement_rounds; ++round) {
     std::vector<PoseGraphEdge> edges;
     for (std::size_t i = 0; i + 1 < poses_.size(); ++i) {
