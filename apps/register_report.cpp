@@ -20,13 +20,13 @@ nlohmann::json poseJson(const Pose& pose) {
 
 std::string verificationSummary(const registration::VerifiedIcp& result) {
   char text[256];
-  std::snprintf(text, sizeof text, "%s: %.0f %% explained, residual spread %.2f cm (noise %.2f cm), %d ICP run%s%s",
+  std::snprintf(text, sizeof text, "%s: %.0f %% explained, residual spread %.2f cm (expected %.2f cm), %d ICP run%s%s",
                 result.verified        ? "verified"
                 : result.unconstrained ? "UNCONSTRAINED (a direction is free)"
                 : result.no_overlap    ? "NO OVERLAP"
                                        : "NOT VERIFIED",
                 100.0 * result.check.explained_share,
-                100.0 * result.check.spread, 100.0 * result.noise, result.attempts, result.attempts == 1 ? "" : "s",
+                100.0 * result.check.spread, 100.0 * result.check.sigma, result.attempts, result.attempts == 1 ? "" : "s",
                 result.icp.degenerate ? ", degenerate geometry" : "");
   return text;
 }
@@ -52,6 +52,7 @@ void writeRegisterReport(const std::string& path, const std::vector<ScanReport>&
                             {"residual_spread_m", r.check.spread},
                             {"expected_residual_m", r.check.sigma},
                             {"noise_m", r.noise},
+                            {"source_noise_m", r.source_noise},
                             {"icp_runs", r.attempts},
                             {"retries", r.attempts > 0 ? r.attempts - 1 : 0},
                             {"iterations", r.icp.iterations},

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <optional>
 
@@ -16,9 +17,6 @@ namespace {
 constexpr double kMadToSigma = 1.4826;
 // A surface is level (floor, ceiling, table) when its normal is within 45 deg of vertical.
 constexpr double kLevelNormal = 0.7071;
-// The noise is measured on every this-many-th voxel of the target: a few thousand voxels
-// give the median to a few per cent.
-constexpr std::size_t kNoiseStride = 4;
 // m, the most the start's yaw error adds to the first gate: a source far from its own
 // origin (a map 60 m away) would otherwise make every search visit thousands of voxels.
 constexpr double kMaxYawReach = 1.5;
@@ -57,6 +55,15 @@ double cloudRadius(const std::vector<Point>& source) {
 }
 
 }  // namespace
+
+double cloudNoise(const std::vector<Point>& points, double voxel_size, double min_noise) {
+  // Every point kept (a down-sampled source has about one a voxel): the noise of these
+  // points, not of a sample of them.
+  VoxelHashMap cloud(voxel_size, std::numeric_limits<std::uint32_t>::max());
+  cloud.addPoints(points);
+  cloud.estimateNormals(NormalConfig{.radius = 2.0 * voxel_size});
+  return std::max(min_noise, cloud.surfaceNoise());
+}
 
 Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& pose,
                              double sigma, double gate, const BasinConfig& config) {
@@ -145,9 +152,11 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
     out.reason = source.empty() ? "no source points" : "empty target";
     return out;
   }
-  // The expected residual: both clouds carry the measured noise.
-  out.noise = config.noise > 0.0 ? config.noise : std::max(config.min_noise, target.planeNoise(kNoiseStride));
-  const double sigma = std::sqrt(2.0) * out.noise;
+  // The expected residual: both clouds carry their measured noise.
+  out.noise = config.noise > 0.0 ? config.noise : std::max(config.min_noise, target.surfaceNoise());
+  out.source_noise =
+      config.source_noise > 0.0 ? config.source_noise : cloudNoise(source, target.voxelSize(), config.min_noise);
+  const double sigma = std::hypot(out.noise, out.source_noise);
   // The verification gate reaches past a misalignment's residuals (so their spread shows)
   // but not past the ICP's own final gate.
   const double gate = std::max(icp.min_max_distance, 10.0 * sigma);

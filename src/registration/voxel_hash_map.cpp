@@ -189,7 +189,8 @@ std::vector<Point> VoxelHashMap::within(const Point& query, double radius) const
 }
 
 void VoxelHashMap::estimateNormals(const NormalConfig& config) {
-  const std::vector<VoxelKey> stencil = sphereStencil(config.radius * inverse_size_);
+  stencil_ = sphereStencil(config.radius * inverse_size_);
+  const std::vector<VoxelKey>& stencil = stencil_;
   // The voxels to (re)estimate: those that gained points and, when only some did, the
   // neighbours whose stencil reaches them (their neighbourhood changed too).
   const std::size_t voxels = table_.size();
@@ -235,18 +236,26 @@ void VoxelHashMap::estimateNormals(const NormalConfig& config) {
   std::fill(dirty_.begin(), dirty_.end(), 0);
 }
 
-double VoxelHashMap::planeNoise(std::size_t stride) const {
+double VoxelHashMap::surfaceNoise(std::size_t max_voxels) const {
   std::vector<double> distances;
-  stride = std::max<std::size_t>(1, stride);
+  const std::size_t stride = std::max<std::size_t>(1, table_.size() / std::max<std::size_t>(1, max_voxels));
   for (std::size_t v = 0; v < table_.size(); v += stride) {
-    const std::size_t count = pointsIn(v);
-    if (count < 3 || normals_[v].isZero()) continue;
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (std::uint32_t k = begin_[v]; k < begin_[v + 1]; ++k) mean += points_[k];
-    mean /= static_cast<double>(count);
-    // n points about their mean have n − 1 degrees of freedom along the normal: scale so
-    // the spread estimates the noise of one point, not of its deviation from the mean.
-    const double dof = std::sqrt(static_cast<double>(count) / static_cast<double>(count - 1));
+    if (normals_[v].isZero()) continue;
+    const VoxelKey own = table_.key(static_cast<std::uint32_t>(v));
+    std::size_t count = 0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();  // about this voxel's centre
+    for (const VoxelKey& offset : stencil_) {
+      const std::uint32_t index = table_.find(own + offset);
+      if (index == VoxelTable::kMissing) continue;
+      count += pointsIn(index);
+      sum += moments_[index].sum + static_cast<double>(pointsIn(index)) *
+                                       Eigen::Vector3d(offset.x, offset.y, offset.z) * voxel_size_;
+    }
+    if (count <= 3) continue;
+    const Point mean = centreOf(own) + sum / static_cast<double>(count);
+    // A plane fitted to n points leaves n − 3 degrees of freedom across it: scale so the
+    // spread estimates one point's noise, not its deviation from a plane fitted through it.
+    const double dof = std::sqrt(static_cast<double>(count) / static_cast<double>(count - 3));
     for (std::uint32_t k = begin_[v]; k < begin_[v + 1]; ++k) {
       distances.push_back(dof * std::abs(normals_[v].dot(points_[k] - mean)));
     }

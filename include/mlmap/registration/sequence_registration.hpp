@@ -71,7 +71,8 @@ class SequenceRegistration {
  private:
   // The mean truncated squared point-to-plane residual of the pairs' scans at `poses`.
   double pairResidual(const std::vector<std::pair<std::size_t, std::size_t>>& pairs, const std::vector<Pose>& poses,
-                      const std::vector<VoxelHashMap>& locals, const std::vector<double>& noise) const;
+                      const std::vector<VoxelHashMap>& locals, const std::vector<double>& noise,
+                      const std::vector<double>& source_noise) const;
 
   SequenceConfig config_;
   VoxelHashMap map_;

@@ -1,6 +1,6 @@
 // ICP with a wide basin and a check of its answer. First one alignPoints run exactly as
 // asked (the caller's gate: an easy pair costs one run and one check); its result is
-// verified against the noise measured on the target (the share of source points it
+// verified against the noise measured on both clouds (the share of source points it
 // explains, the spread of their residuals) and against the geometry (the eigenvalues of the
 // normal equations at the result: a corridor leaves its axis free, and a result there is
 // "unconstrained", not verified). Only when it is not verified does the wide basin run
@@ -37,8 +37,9 @@ struct BasinConfig {
   // spread of their residuals is at most max_spread_ratio · σ. (The share of all source
   // points follows the target's sampling of the far field, not the alignment: the lab's
   // and the corridor's scans match 10-25 % of their points at the true pose.)
-  double noise = 0.0;                   // m, the target's noise; 0 = measured (VoxelHashMap::planeNoise)
-  double min_noise = 0.002;             // m, floor of the measured noise (centroids of dense voxels)
+  double noise = 0.0;                   // m, the target's noise; 0 = measured (VoxelHashMap::surfaceNoise)
+  double source_noise = 0.0;            // m, the source's; 0 = measured (cloudNoise)
+  double min_noise = 0.002;             // m, floor of each measured noise (centroids of dense voxels)
   double explained_sigmas = 3.0;
   double min_explained_share = 0.5;    // of the matched points
   std::size_t min_matched = 100;       // IcpConfig::min_inliers
@@ -77,6 +78,7 @@ struct VerifiedIcp {
   Pose start = Pose::Identity();  // the start given
   Pose kept_start = Pose::Identity();  // the start the kept result ran from
   double noise = 0.0;          // m, the target noise used
+  double source_noise = 0.0;   // m, the source noise used
   int attempts = 0;            // ICP runs (1: no retry)
   double first_matched_share = 0.0;  // of the first run: source points matched within the gate
   bool verified = false;       // explains the overlap and the geometry constrains every direction
@@ -84,6 +86,10 @@ struct VerifiedIcp {
   bool no_overlap = false;     // the first run matched almost nothing: not retried
   std::string reason;          // why not verified; empty when verified
 };
+
+// The surface noise of a cloud as it is, m: VoxelHashMap::surfaceNoise of a voxel hash of it
+// (`voxel_size`, normals over twice that radius), at least `min_noise`.
+double cloudNoise(const std::vector<Point>& points, double voxel_size, double min_noise);
 
 // The point-to-plane verification of `pose` (source -> target) with expected residual
 // `sigma` (m); points match within `gate` (m; the overload without: max(0.1, 10 σ)).

@@ -50,10 +50,15 @@ class VoxelHashMap {
   // Every point within `radius` of `query`, in no particular order.
   std::vector<Point> within(const Point& query, double radius) const;
 
-  // The noise of the map's surfaces, m: the robust (MAD) spread of the points' distances
-  // from their voxel's plane (its normal through its points' mean), over the voxels with a
-  // normal and at least 3 points; every `stride`-th voxel; 0 when none qualifies.
-  double planeNoise(std::size_t stride = 1) const;
+  // The noise of the map's surfaces as ICP meets them, m: the robust (MAD) spread of the
+  // points' distances from their neighbourhood's plane (the points of the voxels whose
+  // centres lie within the last estimateNormals() radius, the voxel's normal through their
+  // mean), scaled for the plane's 3 fitted degrees of freedom; over at most `max_voxels`
+  // voxels with a normal, spread evenly; 0 when none qualifies. The neighbourhood, not the
+  // voxel alone: a voxel's few points share its bias (down-sampled centroids, points split
+  // by a voxel boundary near the surface), which its neighbours do not (the simulated lab:
+  // 0.21 cm within voxels, 0.47 cm about the neighbourhood, residuals at the true pose 0.62 cm).
+  double surfaceNoise(std::size_t max_voxels = 4000) const;
 
   std::vector<Point> points() const;
   std::size_t size() const { return points_.size(); }
@@ -84,6 +89,7 @@ class VoxelHashMap {
   std::vector<Normal> normals_;          // shared by the voxel's points
   std::vector<Moments> moments_;
   std::vector<char> dirty_;              // gained points since the last estimateNormals()
+  std::vector<VoxelKey> stencil_;        // the neighbourhood of the last estimateNormals()
 };
 
 }  // namespace mlmap::registration
