@@ -9,6 +9,7 @@
 // order of a depth-first walk of the OcTree.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -64,6 +65,15 @@ class KeyBits {
     (*cached_words_)[bit >> 6] |= std::uint64_t{1} << (bit & 63U);
   }
   void insert(const octomap::OcTreeKey& key) { insert(key[0], key[1], key[2]); }
+
+  // Empties the set, keeping its memory for the next scan.
+  void clear() {
+    std::fill(slots_.begin(), slots_.end(), 0);
+    codes_.clear();
+    words_.clear();
+    cached_chunk_ = ~std::uint64_t{0};
+    cached_words_ = nullptr;
+  }
 
   // The chunks in the order they were first touched, by Morton code of the chunk.
   const std::vector<std::uint64_t>& chunkCodes() const { return codes_; }
