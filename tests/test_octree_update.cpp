@@ -6,7 +6,12 @@
 #include <cmath>
 #include <vector>
 
+#include "../src/map/octree_update.hpp"
 #include "mlmap/map/map.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 using namespace mlmap;
 
@@ -150,4 +155,82 @@ TEST_CASE("OcTree update: scans added to a pruned tree expand only the nodes the
   checkVoxelsIn(map.octree(), reference);
   checkVoxelsIn(reference, map.octree());
   CHECK(innerNodesOutOfDate(map.octree()) == 0);
+}
+
+namespace {
+
+// The scans into `tree` with the subtrees split at `split_depth`, on two threads.
+void insertSplit(octomap::OcTree& tree, const std::vector<Scan>& scans, unsigned split_depth) {
+#ifdef _OPENMP
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(2);
+#endif
+  for (const Scan& scan : scans) detail::insertRays(tree, scan, {-1.0, false, split_depth});
+#ifdef _OPENMP
+  omp_set_num_threads(threads);
+#endif
+}
+
+void checkSameTrees(const octomap::OcTree& ours, const octomap::OcTree& reference) {
+  CHECK(checkVoxelsIn(ours, reference) == checkVoxelsIn(reference, ours));
+  CHECK(innerNodesOutOfDate(ours) == 0);
+  CHECK(ours.size() == ours.calcNumNodes());  // the node count kept beside the threads' walks
+  CHECK(ours.size() == reference.size());
+}
+
+// Every voxel of the 32³ block below and beside the room's centre saturated free, then
+// pruned: one leaf at depth 11 that the scans' hits must expand and their misses leave.
+void saturateBlock(octomap::OcTree& tree) {
+  for (unsigned x = 32736; x < 32768; ++x) {
+    for (unsigned y = 32736; y < 32768; ++y) {
+      for (unsigned z = 32768; z < 32800; ++z) {
+        tree.setNodeValue(octomap::OcTreeKey(static_cast<octomap::key_type>(x), static_cast<octomap::key_type>(y),
+                                             static_cast<octomap::key_type>(z)),
+                          tree.getClampingThresMinLog(), true);
+      }
+    }
+  }
+  tree.updateInnerOccupancy();
+  tree.prune();
+}
+
+}  // namespace
+
+TEST_CASE("OcTree update: subtrees updated on two threads give OctoMap's tree at any split depth") {
+  const std::vector<Scan> scans = roomScans();
+  const octomap::OcTree reference = octomapReference(scans, 0.07, -1.0, true);
+  for (const unsigned split : {1U, 5U, 9U, 11U, 12U}) {
+    CAPTURE(split);
+    octomap::OcTree tree(0.07);
+    insertSplit(tree, scans, split);
+    checkSameTrees(tree, reference);
+  }
+}
+
+TEST_CASE("OcTree update: a pruned node above the split depth is expanded as OctoMap expands it") {
+  const std::vector<Scan> scans = roomScans();
+  octomap::OcTree reference(0.1);
+  saturateBlock(reference);
+  REQUIRE(reference.search(octomap::OcTreeKey(32740, 32740, 32770), 11) != nullptr);
+  REQUIRE_FALSE(reference.nodeHasChildren(reference.search(octomap::OcTreeKey(32740, 32740, 32770), 11)));
+  for (const Scan& scan : scans) {
+    octomap::Pointcloud cloud;
+    for (std::size_t p = 0; p < scan.size(); ++p) {
+      const Eigen::Vector3d world = scan.worldPoint(p);
+      cloud.push_back(static_cast<float>(world.x()), static_cast<float>(world.y()), static_cast<float>(world.z()));
+    }
+    const Eigen::Vector3d origin = scan.pose.translation();
+    reference.insertPointCloud(cloud,
+                               octomap::point3d(static_cast<float>(origin.x()), static_cast<float>(origin.y()),
+                                                static_cast<float>(origin.z())),
+                               -1.0, false, true);
+  }
+  // Split below the pruned leaf (the serial walk), at it (a subtree's top) and above it.
+  for (const unsigned split : {12U, 11U, 6U}) {
+    CAPTURE(split);
+    octomap::OcTree tree(0.1);
+    saturateBlock(tree);
+    insertSplit(tree, scans, split);
+    checkSameTrees(tree, reference);
+  }
 }

@@ -9,6 +9,7 @@
 // order of a depth-first walk of the OcTree.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -54,19 +55,25 @@ class KeyBits {
  public:
   KeyBits() : slots_(64, 0), slot_index_(64, 0) {}
 
-  void insert(unsigned x, unsigned y, unsigned z) {
+  // Inlined into the ray loop; the chunk change (one step in ~16) is not.
+  [[gnu::always_inline]] void insert(unsigned x, unsigned y, unsigned z) {
     const std::uint64_t chunk = (x >> kChunkBits) | (static_cast<std::uint64_t>(y >> kChunkBits) << 16) |
                                 (static_cast<std::uint64_t>(z >> kChunkBits) << 32);
-    if (chunk != cached_chunk_) {
-      cached_chunk_ = chunk;
-      cached_words_ = &words_[chunkIndex(spreadBits(x >> kChunkBits) | (spreadBits(y >> kChunkBits) << 1) |
-                                         (spreadBits(z >> kChunkBits) << 2))];
-    }
+    if (chunk != cached_chunk_) [[unlikely]] switchChunk(chunk);
     const unsigned mask = (1U << kChunkBits) - 1;
     const unsigned bit = kInChunk[x & mask] | (kInChunk[y & mask] << 1) | (kInChunk[z & mask] << 2);
     (*cached_words_)[bit >> 6] |= std::uint64_t{1} << (bit & 63U);
   }
   void insert(const octomap::OcTreeKey& key) { insert(key[0], key[1], key[2]); }
+
+  // Empties the set, keeping its memory for the next scan.
+  void clear() {
+    std::fill(slots_.begin(), slots_.end(), 0);
+    codes_.clear();
+    words_.clear();
+    cached_chunk_ = ~std::uint64_t{0};
+    cached_words_ = nullptr;
+  }
 
   // The chunks in the order they were first touched, by Morton code of the chunk.
   const std::vector<std::uint64_t>& chunkCodes() const { return codes_; }
@@ -86,6 +93,14 @@ class KeyBits {
     for (unsigned v = 0; v < table.size(); ++v) table[v] = static_cast<unsigned>(spreadBits(v));
     return table;
   }();
+
+  [[gnu::noinline]] void switchChunk(std::uint64_t chunk) {
+    cached_chunk_ = chunk;
+    const std::uint64_t x = chunk & 0xFFFFU;
+    const std::uint64_t y = (chunk >> 16) & 0xFFFFU;
+    const std::uint64_t z = chunk >> 32;
+    cached_words_ = &words_[chunkIndex(spreadBits(x) | (spreadBits(y) << 1) | (spreadBits(z) << 2))];
+  }
 
   static std::size_t hashOf(std::uint64_t code) {
     return static_cast<std::size_t>((code * 0x9E3779B97F4A7C15ULL) >> 20);

@@ -143,6 +143,11 @@ std::size_t MLMap::findOrCreateCell(CellIndex cell) {
   return last_cell_ = cells_.size() - 1;
 }
 
+void MLMap::reserveArena(std::size_t extra) {
+  // Geometric, as the vector's own growth: reserve() alone takes exactly what is asked.
+  if (blocks_.size() + extra > blocks_.capacity()) blocks_.reserve(std::max(blocks_.size() + extra, 2 * blocks_.capacity()));
+}
+
 void MLMap::reserveCell(Cell& cell, std::size_t capacity) {
   if (capacity <= cell.capacity) return;
   if (capacity > kMaxBlocksPerCell) throw Error("a cell holds too many blocks");
@@ -230,18 +235,27 @@ void MLMap::insertScan(const Scan& scan) {
     std::size_t cell_number;
   };
   std::vector<Run> runs;
+  std::size_t new_cells = 0;
   for (std::size_t begin = 0; begin < count;) {
     const CellIndex cell = cells[order[begin]];
     std::size_t end = begin + 1;
     while (end < count && cells[order[end]] == cell) ++end;
     const std::size_t cell_number = findOrCreateCell(cell);
-    if (cells_[cell_number].capacity == 0) reserveCell(cells_[cell_number], 2);
+    new_cells += cells_[cell_number].capacity == 0 ? 1 : 0;
     runs.push_back(Run{begin, end, cell_number});
     begin = end;
   }
+  // The arena grows once per scan, not once per doubling: each growth copies all of it.
+  reserveArena(2 * new_cells);
+  for (const Run& run : runs) {
+    if (cells_[run.cell_number].capacity == 0) reserveCell(cells_[run.cell_number], 2);
+  }
 
-  // Each run updates its own cell: in parallel, on a scratch copy written back in
-  // place when it fits; cells that outgrow their room are written back afterwards.
+  // Each run updates its own cell, in parallel: in place in the cell's room in the
+  // arena (no other run touches it), moving to a scratch copy only when a new block
+  // would not fit (blocks are 60 bytes with their points' moments: copying each run
+  // in and out is memory traffic); cells that outgrow their room are written back
+  // afterwards.
   struct Outgrown {
     std::size_t cell_number;
     std::vector<Block> blocks;
@@ -258,33 +272,49 @@ void MLMap::insertScan(const Scan& scan) {
     for (std::int64_t r = 0; r < run_count; ++r) {
       const Run& run = runs[static_cast<std::size_t>(r)];
       Cell& cell = cells_[run.cell_number];
-      const Block* stored = blocks_.data() + cell.first;
-      scratch.assign(stored, stored + cell.count);
-      scratch.resize(cell.count + (run.end - run.begin));  // a measurement adds at most one block
+      Block* blocks = blocks_.data() + cell.first;
+      std::size_t room = cell.capacity;
       int blocks_in_cell = cell.count;
       for (std::size_t k = run.begin; k < run.end; ++k) {
+        if (static_cast<std::size_t>(blocks_in_cell) + 1 > room) {  // a measurement adds at most one block
+          const std::size_t wanted = std::max<std::size_t>(2 * room, static_cast<std::size_t>(blocks_in_cell) + 1);
+          if (blocks != scratch.data()) {
+            scratch.resize(std::max(scratch.size(), wanted));
+            std::copy_n(blocks, blocks_in_cell, scratch.begin());
+          } else {
+            scratch.resize(wanted);
+          }
+          blocks = scratch.data();
+          room = scratch.size();
+        }
         const std::uint32_t index = order[k];
         PointStats point;
         point.add(offsets_x[index], offsets_y[index], heights[index]);
-        blocks_in_cell = addMeasurement(scratch.data(), blocks_in_cell, heights[index], heights[index],
-                                        variances[index], reach, point);
+        blocks_in_cell = addMeasurement(blocks, blocks_in_cell, heights[index], heights[index], variances[index],
+                                        reach, point);
       }
       added += blocks_in_cell - cell.count;
-      scratch.resize(static_cast<std::size_t>(blocks_in_cell));
       if (blocks_in_cell <= cell.capacity) {
-        std::copy(scratch.begin(), scratch.end(), blocks_.begin() + cell.first);
+        if (blocks != blocks_.data() + cell.first) std::copy_n(blocks, blocks_in_cell, blocks_.begin() + cell.first);
         cell.count = static_cast<std::uint16_t>(blocks_in_cell);
       } else {
-        local_outgrown.push_back(Outgrown{run.cell_number, scratch});
+        local_outgrown.push_back(Outgrown{run.cell_number, std::vector<Block>(blocks, blocks + blocks_in_cell)});
       }
     }
 #pragma omp critical(mlmap_outgrown_cells)
     outgrown.insert(outgrown.end(), std::make_move_iterator(local_outgrown.begin()),
                     std::make_move_iterator(local_outgrown.end()));
   }
+  // A cell that outgrew its room moves to the arena's end with room to grow as much
+  // again: given only what it holds, it outgrows it at the next new surface and moves
+  // again, each move leaving a dead run in the arena that every growth copies.
+  const auto grownRoom = [](std::size_t blocks) { return std::min(kMaxBlocksPerCell, 2 * blocks); };
+  std::size_t grown_room = 0;
+  for (const Outgrown& grown : outgrown) grown_room += grownRoom(grown.blocks.size());
+  reserveArena(grown_room);
   for (Outgrown& grown : outgrown) {
     Cell& cell = cells_[grown.cell_number];
-    reserveCell(cell, grown.blocks.size());
+    reserveCell(cell, grownRoom(grown.blocks.size()));
     std::copy(grown.blocks.begin(), grown.blocks.end(), blocks_.begin() + cell.first);
     cell.count = static_cast<std::uint16_t>(grown.blocks.size());
   }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "key_bits.hpp"
+#include "octree_walk.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -68,20 +69,38 @@ void castRay(const octomap::OcTree& tree, const point3d& origin, const point3d& 
       t_delta[i] = std::numeric_limits<double>::max();
     }
   }
-  std::array<unsigned, 3> key{key_origin[0], key_origin[1], key_origin[2]};
+  // computeRayKeys' step with the three t and keys in registers instead of indexed
+  // arrays (a store and reload per step), the key comparison as one test and the
+  // key set's bit insert inlined: 1.6x the rays per second. The axis: 0 when t0 < t1
+  // and t0 < t2, 1 when t1 <= t0 and t1 < t2, else 2, the choices of its if/else.
+  // (Masks instead of branches were slower: the axis pattern along one ray predicts
+  // well.) Adding 0.0 leaves a t unchanged.
+  double t0 = t_max[0];
+  double t1 = t_max[1];
+  double t2 = t_max[2];
+  unsigned k0 = key_origin[0];
+  unsigned k1 = key_origin[1];
+  unsigned k2 = key_origin[2];
+  const auto step0 = static_cast<unsigned>(step[0]);
+  const auto step1 = static_cast<unsigned>(step[1]);
+  const auto step2 = static_cast<unsigned>(step[2]);
+  const double length_d = length;
   for (;;) {
-    unsigned dim = 0;
-    if (t_max[0] < t_max[1]) {
-      dim = t_max[0] < t_max[2] ? 0 : 2;
-    } else {
-      dim = t_max[1] < t_max[2] ? 1 : 2;
-    }
-    key[dim] = (key[dim] + static_cast<unsigned>(step[dim])) & 0xFFFFU;  // key_type arithmetic
-    t_max[dim] += t_delta[dim];
-    if (key[0] == key_end[0] && key[1] == key_end[1] && key[2] == key_end[2]) return;
+    const bool before_1 = t0 < t1;
+    const bool axis0 = before_1 && t0 < t2;
+    const bool axis1 = !before_1 && t1 < t2;
+    const bool axis2 = !axis0 && !axis1;
+    k0 = (k0 + (axis0 ? step0 : 0U)) & 0xFFFFU;  // key_type arithmetic
+    k1 = (k1 + (axis1 ? step1 : 0U)) & 0xFFFFU;
+    k2 = (k2 + (axis2 ? step2 : 0U)) & 0xFFFFU;
+    t0 += axis0 ? t_delta[0] : 0.0;
+    t1 += axis1 ? t_delta[1] : 0.0;
+    t2 += axis2 ? t_delta[2] : 0.0;
+    if (((k0 ^ key_end[0]) | (k1 ^ key_end[1]) | (k2 ^ key_end[2])) == 0) return;
     // Past the end's distance without meeting its voxel: rounding, stop as OctoMap does.
-    if (std::min(std::min(t_max[0], t_max[1]), t_max[2]) > length) return;
-    free.insert(key[0], key[1], key[2]);
+    const double nearest01 = t1 < t0 ? t1 : t0;
+    if ((t2 < nearest01 ? t2 : nearest01) > length_d) return;
+    free.insert(k0, k1, k2);
   }
 }
 
@@ -103,8 +122,8 @@ struct MergedBits {
   std::vector<ChunkWords> words;
 };
 
-MergedBits merge(const std::vector<KeyBits>& sets) {
-  MergedBits merged;
+void merge(const std::vector<KeyBits>& sets, MergedBits& merged) {
+  merged.codes.clear();
   for (const KeyBits& set : sets) {
     merged.codes.insert(merged.codes.end(), set.chunkCodes().begin(), set.chunkCodes().end());
   }
@@ -122,8 +141,27 @@ MergedBits merge(const std::vector<KeyBits>& sets) {
       for (std::size_t w = 0; w < kChunkWords; ++w) out[w] |= (*in)[w];
     }
   }
-  return merged;
 }
+
+// The key sets of one scan, kept on the calling thread for the next: they span
+// megabytes, and fresh ones each scan cost page faults and zeroing (12 % of the
+// insertion at 5 cm).
+struct RayBuffers {
+  std::vector<KeyBits> free;
+  std::vector<KeyBits> hit;
+  std::vector<KeyBits> ends;
+  MergedBits merged_free;
+  MergedBits merged_hit;
+  MergedBits merged_ends;
+
+  // n empty sets each
+  void reset(std::size_t n) {
+    for (std::vector<KeyBits>* sets : {&free, &hit, &ends}) {
+      sets->resize(n);
+      for (KeyBits& set : *sets) set.clear();
+    }
+  }
+};
 
 template <typename Visit>
 void forEachCode(std::uint64_t chunk_code, std::size_t word, std::uint64_t bits, Visit&& visit) {
@@ -134,117 +172,20 @@ void forEachCode(std::uint64_t chunk_code, std::size_t word, std::uint64_t bits,
   }
 }
 
-// Updates the tree one key at a time in Morton (depth-first) order, keeping the path
-// of the previous key: a key descends only from the deepest node it shares with the
-// previous one, and an inner node is brought up to date (or pruned) once, when the
-// walk leaves it. Each step is the one OccupancyOcTreeBase::updateNodeRecurs takes.
-class TreeWalk {
- public:
-  explicit TreeWalk(octomap::OcTree& tree) : tree_(tree) {}
-
-  void visit(std::uint64_t code, float update) {
-    if (!started_) {
-      started_ = true;
-      if (tree_.getRoot() == nullptr) {  // only updateNode may create the root
-        tree_.updateNode(keyOfMorton(code), update, true);
-        path_[0] = tree_.getRoot();
-        for (unsigned d = 0; d < kDepth; ++d) path_[d + 1] = tree_.getNodeChild(path_[d], childOf(code, d));
-        valid_ = kDepth;
-        previous_ = code;
-        return;
-      }
-      path_[0] = tree_.getRoot();
-      created_[0] = false;
-      valid_ = 0;
-    } else {
-      const auto group = static_cast<unsigned>(63 - std::countl_zero(code ^ previous_)) / 3;
-      close(kDepth - 1 - group);
-    }
-    previous_ = code;
-    for (unsigned d = valid_; d < kDepth; ++d) {
-      octomap::OcTreeNode* node = path_[d];
-      const unsigned child = childOf(code, d);
-      created_[d + 1] = false;
-      if (!tree_.nodeChildExists(node, child)) {
-        if (!tree_.nodeHasChildren(node) && !created_[d]) {
-          // A pruned node: updateNode's early abort leaves it whole when saturated.
-          if (saturated(*node, update)) {
-            valid_ = d;
-            return;
-          }
-          tree_.expandNode(node);
-        } else {
-          tree_.createNodeChild(node, child);
-          created_[d + 1] = true;
-        }
-      }
-      path_[d + 1] = tree_.getNodeChild(node, child);
-    }
-    valid_ = kDepth;
-    if (!saturated(*path_[kDepth], update)) tree_.updateNodeLogOdds(path_[kDepth], update);
-  }
-
-  // Brings the nodes still on the path up to date, the root last.
-  void finish() {
-    if (!started_) return;
-    close(0);
-    settle(path_[0]);
-  }
-
- private:
-  static constexpr unsigned kDepth = 16;
-
-  static unsigned childOf(std::uint64_t code, unsigned depth) {
-    return static_cast<unsigned>(code >> (3 * (kDepth - 1 - depth))) & 7U;
-  }
-
-  bool saturated(const octomap::OcTreeNode& node, float update) const {
-    return (update >= 0 && node.getLogOdds() >= tree_.getClampingThresMaxLog()) ||
-           (update <= 0 && node.getLogOdds() <= tree_.getClampingThresMinLog());
-  }
-
-  void settle(octomap::OcTreeNode* node) {
-    if (!tree_.nodeHasChildren(node)) return;
-    if (!tree_.pruneNode(node)) node->updateOccupancyChildren();
-  }
-
-  // Leaves the nodes deeper than `depth`, deepest first.
-  void close(unsigned depth) {
-    for (; valid_ > depth; --valid_) {
-      if (valid_ < kDepth) settle(path_[valid_]);
-    }
-  }
-
-  octomap::OcTree& tree_;
-  std::array<octomap::OcTreeNode*, kDepth + 1> path_{};
-  std::array<bool, kDepth + 1> created_{};
-  unsigned valid_ = 0;  // path_[0..valid_] are the previous key's nodes
-  bool started_ = false;
-  std::uint64_t previous_ = 0;
-};
-
-// Free voxels minus hit ones with the miss update, hit ones with the hit update, in
-// ascending Morton code.
-void updateTree(octomap::OcTree& tree, const MergedBits& free, const MergedBits& hit) {
-  TreeWalk walk(tree);
-  const float miss_update = tree.getProbMissLog();
-  const float hit_update = tree.getProbHitLog();
-  static const ChunkWords kNone{};
+// The free and hit sets side by side, chunk by chunk in ascending code.
+std::vector<ChunkUpdate> chunkUpdates(const MergedBits& free, const MergedBits& hit) {
+  std::vector<ChunkUpdate> chunks;
+  chunks.reserve(std::max(free.codes.size(), hit.codes.size()));
   std::size_t f = 0;
   std::size_t h = 0;
   while (f < free.codes.size() || h < hit.codes.size()) {
     const std::uint64_t code = std::min(f < free.codes.size() ? free.codes[f] : ~std::uint64_t{0},
                                         h < hit.codes.size() ? hit.codes[h] : ~std::uint64_t{0});
-    const ChunkWords& free_words = f < free.codes.size() && free.codes[f] == code ? free.words[f++] : kNone;
-    const ChunkWords& hit_words = h < hit.codes.size() && hit.codes[h] == code ? hit.words[h++] : kNone;
-    for (std::size_t w = 0; w < kChunkWords; ++w) {
-      const std::uint64_t hits = hit_words[w];
-      forEachCode(code, w, free_words[w] | hits, [&](std::uint64_t key_code) {
-        walk.visit(key_code, (hits >> (key_code & 63U)) & 1U ? hit_update : miss_update);
-      });
-    }
+    const ChunkWords* free_words = f < free.codes.size() && free.codes[f] == code ? &free.words[f++] : nullptr;
+    const ChunkWords* hit_words = h < hit.codes.size() && hit.codes[h] == code ? &hit.words[h++] : nullptr;
+    chunks.push_back(ChunkUpdate{code, free_words, hit_words});
   }
-  walk.finish();
+  return chunks;
 }
 
 }  // namespace
@@ -258,9 +199,10 @@ void insertRays(octomap::OcTree& tree, const Scan& scan, const RayOptions& optio
     const Eigen::Vector3d world = scan.worldPoint(static_cast<std::size_t>(index));
     return point3d(static_cast<float>(world.x()), static_cast<float>(world.y()), static_cast<float>(world.z()));
   };
-  const auto threads = static_cast<std::size_t>(threadCount());
-  std::vector<KeyBits> free(threads);
-  std::vector<KeyBits> hit(threads);
+  static thread_local RayBuffers buffers;
+  buffers.reset(static_cast<std::size_t>(threadCount()));
+  std::vector<KeyBits>& free = buffers.free;
+  std::vector<KeyBits>& hit = buffers.hit;
   if (options.exact_rays) {
 #pragma omp parallel for schedule(dynamic, 4096)
     for (std::int64_t index = 0; index < point_count; ++index) {
@@ -270,16 +212,14 @@ void insertRays(octomap::OcTree& tree, const Scan& scan, const RayOptions& optio
   } else {
     // OctoMap's computeDiscreteUpdate: one ray to the centre of each voxel that holds
     // end points (the range limit applies to that centre too).
-    MergedBits ends;
-    {
-      std::vector<KeyBits> end_sets(threads);
+    std::vector<KeyBits>& end_sets = buffers.ends;
 #pragma omp parallel for schedule(static)
-      for (std::int64_t index = 0; index < point_count; ++index) {
-        OcTreeKey key;
-        if (tree.coordToKeyChecked(endPoint(index), key)) end_sets[static_cast<std::size_t>(threadIndex())].insert(key);
-      }
-      ends = merge(end_sets);
+    for (std::int64_t index = 0; index < point_count; ++index) {
+      OcTreeKey key;
+      if (tree.coordToKeyChecked(endPoint(index), key)) end_sets[static_cast<std::size_t>(threadIndex())].insert(key);
     }
+    const MergedBits& ends = buffers.merged_ends;
+    merge(end_sets, buffers.merged_ends);
     const auto chunk_count = static_cast<std::int64_t>(ends.codes.size());
 #pragma omp parallel for schedule(dynamic, 4)
     for (std::int64_t c = 0; c < chunk_count; ++c) {
@@ -293,7 +233,9 @@ void insertRays(octomap::OcTree& tree, const Scan& scan, const RayOptions& optio
       }
     }
   }
-  updateTree(tree, merge(free), merge(hit));
+  merge(free, buffers.merged_free);
+  merge(hit, buffers.merged_hit);
+  updateTree(tree, chunkUpdates(buffers.merged_free, buffers.merged_hit), options.split_depth);
 }
 
 }  // namespace mlmap::detail

@@ -72,6 +72,7 @@ class MLMap {
 
   std::size_t findOrCreateCell(CellIndex cell);
   void reserveCell(Cell& cell, std::size_t capacity);
+  void reserveArena(std::size_t extra);  // room for `extra` more blocks at the arena's end
   void insertIntoCell(std::size_t cell_number, float top, float bottom, float variance, const PointStats& points);
   void rehash(std::size_t slot_count);
 
