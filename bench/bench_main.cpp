@@ -15,6 +15,7 @@
 #include <string>
 #include <thread>
 
+#include "stopwatch.hpp"
 #include "icp_pairs.hpp"
 #include "octree_insert.hpp"
 #include "icp_starts.hpp"
@@ -29,11 +30,8 @@ int runPacing(int argc, char** argv);
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+using mlmap::bench::Clock;
+using mlmap::bench::secondsSince;
 
 // Peak resident memory of this process so far, in MB (Linux VmHWM).
 double peakMemoryMb() {

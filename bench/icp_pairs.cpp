@@ -6,6 +6,7 @@
 // voxel down-sampling of both scans, the target's voxel hash and normals, then ICP. Times cover
 // those steps, file reading excluded, as the peers' "total"; each is the median over --runs.
 // Output: JSON on stdout; bench/icp_bench.py scores it against poses_true.txt.
+#include "stopwatch.hpp"
 #include "icp_pairs.hpp"
 #include "threads.hpp"
 
@@ -29,12 +30,7 @@
 namespace mlmap::bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using namespace mlmap::registration;
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // CPU seconds of every thread of this process so far: on a shared machine the wall time
 // depends on the other jobs, this much less.

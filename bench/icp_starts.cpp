@@ -8,6 +8,7 @@
 // --plain one alignPoints run at `mlmap register`'s 0.5 m gate (the ICP before the basin).
 // Time per run = the pair's preparation + that run's ICP (the peers time the same steps),
 // file reading excluded. JSON on stdout; bench/icp_stress.py scores it.
+#include "stopwatch.hpp"
 #include "icp_starts.hpp"
 
 #include <chrono>
@@ -27,12 +28,7 @@
 namespace mlmap::bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using namespace mlmap::registration;
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 Pose poseOf(const nlohmann::json& values, const std::string& where) {
   if (!values.is_array() || values.size() != 16) throw Error(where + ": a start must be 16 numbers");
