@@ -522,6 +522,15 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   // floor's noise. Narrowing it found plane_seg's first stair tread at 5 cm cells and
   // lost room walls of PCL's room_scan1 and room_scan2.
   if (again.epsilon <= 0.0) again.epsilon = defaultEpsilon(map, std::max(config.noise, *measured));
+  // σ sets only ε and the level band (never narrower than a cell): where neither moves
+  // (a simulated scan's 0.4 cm against 1 cm assumed, both bands a cell), a second pass
+  // would find the very same planes.
+  const auto levelBand = [&map](double noise) { return std::max(5.0 * noise, map.cellSize()); };
+  if (again.epsilon == detection.config.epsilon && levelBand(again.noise) == levelBand(config.noise)) {
+    detection.config.noise = again.noise;
+    detection.stats.prior_noise = config.noise;
+    return detection;
+  }
   detection = detectOnce(map, again, block_noise);
   detection.stats.prior_noise = config.noise;
   // The first pass was the noise estimate.
