@@ -55,8 +55,8 @@ std::vector<Scan> roomScans() {
   return scans;
 }
 
-octomap::OcTree octomapReference(const std::vector<Scan>& scans, double resolution, double max_range, bool discretize) {
-  octomap::OcTree tree(resolution);
+// The scans into `tree` by OctoMap's own insertPointCloud.
+void insertByOctomap(octomap::OcTree& tree, const std::vector<Scan>& scans, double max_range, bool discretize) {
   for (const Scan& scan : scans) {
     octomap::Pointcloud cloud;
     for (std::size_t p = 0; p < scan.size(); ++p) {
@@ -69,6 +69,11 @@ octomap::OcTree octomapReference(const std::vector<Scan>& scans, double resoluti
                                            static_cast<float>(origin.z())),
                           max_range, false, discretize);
   }
+}
+
+octomap::OcTree octomapReference(const std::vector<Scan>& scans, double resolution, double max_range, bool discretize) {
+  octomap::OcTree tree(resolution);
+  insertByOctomap(tree, scans, max_range, discretize);
   return tree;
 }
 
@@ -213,18 +218,7 @@ TEST_CASE("OcTree update: a pruned node above the split depth is expanded as Oct
   saturateBlock(reference);
   REQUIRE(reference.search(octomap::OcTreeKey(32740, 32740, 32770), 11) != nullptr);
   REQUIRE_FALSE(reference.nodeHasChildren(reference.search(octomap::OcTreeKey(32740, 32740, 32770), 11)));
-  for (const Scan& scan : scans) {
-    octomap::Pointcloud cloud;
-    for (std::size_t p = 0; p < scan.size(); ++p) {
-      const Eigen::Vector3d world = scan.worldPoint(p);
-      cloud.push_back(static_cast<float>(world.x()), static_cast<float>(world.y()), static_cast<float>(world.z()));
-    }
-    const Eigen::Vector3d origin = scan.pose.translation();
-    reference.insertPointCloud(cloud,
-                               octomap::point3d(static_cast<float>(origin.x()), static_cast<float>(origin.y()),
-                                                static_cast<float>(origin.z())),
-                               -1.0, false, true);
-  }
+  insertByOctomap(reference, scans, -1.0, true);
   // Split below the pruned leaf (the serial walk), at it (a subtree's top) and above it.
   for (const unsigned split : {12U, 11U, 6U}) {
     CAPTURE(split);

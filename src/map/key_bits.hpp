@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -49,6 +50,17 @@ inline octomap::OcTreeKey keyOfMorton(std::uint64_t code) {
   return octomap::OcTreeKey(static_cast<octomap::key_type>(compactBits(code)),
                             static_cast<octomap::key_type>(compactBits(code >> 1)),
                             static_cast<octomap::key_type>(compactBits(code >> 2)));
+}
+
+// Calls visit(code) for the Morton code of every set bit of word `word` (`bits`) of the
+// chunk with code `chunk_code`, in ascending order.
+template <typename Visit>
+void forEachCode(std::uint64_t chunk_code, std::size_t word, std::uint64_t bits, Visit&& visit) {
+  while (bits != 0) {
+    const auto bit = static_cast<std::uint64_t>(std::countr_zero(bits));
+    bits &= bits - 1;
+    visit((chunk_code << (3 * kChunkBits)) | (word * 64 + bit));
+  }
 }
 
 class KeyBits {

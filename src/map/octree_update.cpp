@@ -163,15 +163,6 @@ struct RayBuffers {
   }
 };
 
-template <typename Visit>
-void forEachCode(std::uint64_t chunk_code, std::size_t word, std::uint64_t bits, Visit&& visit) {
-  while (bits != 0) {
-    const auto bit = static_cast<std::uint64_t>(std::countr_zero(bits));
-    bits &= bits - 1;
-    visit((chunk_code << (3 * kChunkBits)) | (word * 64 + bit));
-  }
-}
-
 // The free and hit sets side by side, chunk by chunk in ascending code.
 std::vector<ChunkUpdate> chunkUpdates(const MergedBits& free, const MergedBits& hit) {
   std::vector<ChunkUpdate> chunks;

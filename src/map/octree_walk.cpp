@@ -162,15 +162,6 @@ class TreeWalk {
   std::uint64_t previous_ = 0;
 };
 
-template <typename Visit>
-void forEachCode(std::uint64_t chunk_code, std::size_t word, std::uint64_t bits, Visit&& visit) {
-  while (bits != 0) {
-    const auto bit = static_cast<std::uint64_t>(std::countr_zero(bits));
-    bits &= bits - 1;
-    visit((chunk_code << (3 * kChunkBits)) | (word * 64 + bit));
-  }
-}
-
 // The chunks' voxels into a walk, free ones with the miss update, hit ones with the hit update.
 void walkChunks(TreeWalk& walk, const ChunkUpdate* first, const ChunkUpdate* last, float miss_update,
                 float hit_update) {
