@@ -1,7 +1,7 @@
 // Helpers shared by the end-to-end test and screenshot.mjs: headless Debian chromium through
 // playwright-core, and a tiny static file server on 127.0.0.1.
 import { createServer } from 'node:http';
-import { mkdtemp, readFile, stat } from 'node:fs/promises';
+import { mkdtemp, readFile, rm, stat } from 'node:fs/promises';
 import { existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
@@ -21,6 +21,13 @@ export async function launchChromium() {
   // Software WebGL on a shared, loaded machine: loading a page can take well over the 30 s default.
   context.setDefaultTimeout(120_000);
   return { context, userDataDir };
+}
+
+/** Closes what launchChromium started and removes its profile directory; nothing when it never started. */
+export async function closeChromium(browser) {
+  if (!browser) return;
+  await browser.context.close();
+  await rm(browser.userDataDir, { recursive: true, force: true });
 }
 
 /** Waits (within the context's timeout) until the 3D view shows the page's state with every box drawn. */

@@ -10,7 +10,7 @@ import { existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
-import { launchChromium, planesJs, waitDrawn } from './browser.mjs';
+import { closeChromium, launchChromium, planesJs, waitDrawn } from './browser.mjs';
 
 const [input, out, size = '1600x1000', colourMode = 'class', view = 'reset'] = process.argv.slice(2);
 if (!input || !out || !['reset', 'top', 'side'].includes(view)) {
@@ -51,7 +51,6 @@ try {
   await page.screenshot({ path: out });
   console.log(`wrote ${out}`);
 } finally {
-  await browser.context.close();
-  await rm(browser.userDataDir, { recursive: true, force: true });
+  await closeChromium(browser);
   await rm(dir, { recursive: true, force: true });
 }

@@ -6,7 +6,7 @@ import { existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
-import { launchChromium, serveDir, planesJs, waitDrawn } from '../scripts/browser.mjs';
+import { closeChromium, launchChromium, serveDir, planesJs, waitDrawn } from '../scripts/browser.mjs';
 
 const web = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const dist = path.join(web, 'dist', 'index.html');
@@ -35,9 +35,8 @@ before(async () => {
 });
 
 after(async () => {
-  await browser?.context.close();
+  await closeChromium(browser);
   await server?.close();
-  if (browser) await rm(browser.userDataDir, { recursive: true, force: true });
   if (site) await rm(site, { recursive: true, force: true });
 });
 

@@ -10,7 +10,7 @@ import { existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
-import { launchChromium, serveDir, waitDrawn } from '../scripts/browser.mjs';
+import { closeChromium, launchChromium, serveDir, waitDrawn } from '../scripts/browser.mjs';
 
 const web = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const output = path.join(web, 'test-output');
@@ -68,9 +68,8 @@ before(async () => {
 });
 
 after(async () => {
-  await browser?.context.close();
+  await closeChromium(browser);
   await server?.close();
-  if (browser) await rm(browser.userDataDir, { recursive: true, force: true });
   for (const dir of [exportDir, site]) if (dir) await rm(dir, { recursive: true, force: true });
 });
 
