@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <optional>
 
 namespace mlmap {
 namespace {
@@ -77,16 +76,14 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config) {
   auto near = [&](const Plane* level, const Eigen::Vector3d& point) {
     return level != nullptr && std::abs(level->normal.dot(point) + level->offset) < config.level_tolerance;
   };
-  // The labels are written after the search: `floor` and `ceiling` point into `planes`.
-  std::vector<PlaneClass> labels(planes.size(), PlaneClass::Other);
   // Horizontal patches first: risers and steps refer to them.
   for (const std::size_t k : horizontal) {
-    const Plane& plane = planes[k];
+    Plane& plane = planes[k];
     const double z = plane.centroid.z();
     if (near(floor, plane.centroid)) {
-      labels[k] = PlaneClass::Floor;
+      plane.label = PlaneClass::Floor;
     } else if (near(ceiling, plane.centroid)) {
-      labels[k] = PlaneClass::Ceiling;
+      plane.label = PlaneClass::Ceiling;
     } else {
       bool step = false;
       for (const std::size_t other : horizontal) {
@@ -99,13 +96,14 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config) {
       const double above_floor = floor != nullptr ? aboveFloor(plane.centroid) : 0.0;
       const bool below_ceiling = ceiling == nullptr || ceiling->normal.dot(plane.centroid) + ceiling->offset < -config.riser_max;
       if (step && below_ceiling) {
-        labels[k] = PlaneClass::Step;
+        plane.label = PlaneClass::Step;
       } else if (floor != nullptr && above_floor >= config.table_min_height && above_floor <= config.table_max_height) {
-        labels[k] = PlaneClass::Table;
+        plane.label = PlaneClass::Table;
+      } else {
+        plane.label = PlaneClass::Other;
       }
     }
   }
-  for (const std::size_t k : horizontal) planes[k].label = labels[k];
   for (std::size_t k = 0; k < planes.size(); ++k) {
     Plane& plane = planes[k];
     if (std::abs(plane.normal.z()) >= cos_horizontal) continue;

@@ -409,12 +409,12 @@ PatchSet Detector::run(ErmsmStats& stats) {
 // those. Where blocks sit at cell centres (maps without point moments, format 2 and
 // before), never less than a cell: a wall on a cell boundary has blocks half a cell
 // either side of it.
-double defaultEpsilon(const MLMap& map, double noise) {
-  return hasPointStats(map) ? std::max(3.0 * noise, std::min(map.cellSize(), 0.05))
-                            : std::max(map.cellSize(), std::min(3.0 * noise, 0.05));
+double defaultEpsilon(bool at_points, double cell_size, double noise) {
+  return at_points ? std::max(3.0 * noise, std::min(cell_size, 0.05))
+                   : std::max(cell_size, std::min(3.0 * noise, 0.05));
 }
 
-// One detection with σ resolved (config.noise > 0).
+// One detection with σ and ε resolved (config.noise, config.epsilon > 0).
 // `block_noise`: the σ the blocks' variances were fused with (rangeNoise), which the rung
 // test compares them in.
 PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config, double block_noise) {
@@ -430,7 +430,6 @@ PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config, double bl
   };
   ErmsmConfig& config = detection.config;
   config = input_config;
-  if (config.epsilon <= 0.0) config.epsilon = defaultEpsilon(map, config.noise);
   // The blocks' old labels need no clearing: the write-back at the end labels every
   // map block (each lies in one eRMSM block), 0 where no patch took it.
   stats.stages.noise = stage();
@@ -504,16 +503,25 @@ PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config, double bl
 // first σ (what a second pass could change there is within the estimate's own spread
 // between cell sizes).
 PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
-  ErmsmConfig config = input_config;
-  const bool measure = config.noise <= 0.0 && hasPointStats(map);
   const auto start = Clock::now();
+  const bool at_points = hasPointStats(map);
   const double block_noise = rangeNoise(map);
+  ErmsmConfig config = input_config;
+  const bool measure = config.noise <= 0.0 && at_points;
   if (config.noise <= 0.0) config.noise = block_noise;
+  if (config.epsilon <= 0.0) config.epsilon = defaultEpsilon(at_points, map.cellSize(), config.noise);
+  // Seconds before `detection`'s own (the estimates, a first pass) count as the noise stage.
+  const auto chargeNoise = [](PlaneDetection& detection, double seconds) {
+    detection.stats.stages.noise += seconds;
+    detection.stats.direction_seconds += seconds;
+  };
+  const double estimate_seconds = secondsSince(start);
   PlaneDetection detection = detectOnce(map, config, block_noise);
-  if (!measure) return detection;
-  const std::optional<double> measured = surfaceNoise(map, detection.planes);
-  if (!measured || *measured <= 0.0 || std::abs(std::log(*measured / config.noise)) <= std::log(1.25)) return detection;
-  const double first_pass_seconds = secondsSince(start);
+  const std::optional<double> measured = measure ? surfaceNoise(map, detection.planes) : std::nullopt;
+  if (!measured || *measured <= 0.0 || std::abs(std::log(*measured / config.noise)) <= std::log(1.25)) {
+    chargeNoise(detection, estimate_seconds);
+    return detection;
+  }
   ErmsmConfig again = input_config;
   again.noise = *measured;
   // ε is widened by the measurement, never narrowed: a median over all blocks speaks for
@@ -521,21 +529,21 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   // ceiling over a 1 cm floor of tests/test_planes_noisy.cpp) is lost with ε from the
   // floor's noise. Narrowing it found plane_seg's first stair tread at 5 cm cells and
   // lost room walls of PCL's room_scan1 and room_scan2.
-  if (again.epsilon <= 0.0) again.epsilon = defaultEpsilon(map, std::max(config.noise, *measured));
+  if (again.epsilon <= 0.0) again.epsilon = defaultEpsilon(at_points, map.cellSize(), std::max(config.noise, *measured));
   // σ sets only ε and the level band (never narrower than a cell): where neither moves
   // (a simulated scan's 0.4 cm against 1 cm assumed, both bands a cell), a second pass
   // would find the very same planes.
   const auto levelBand = [&map](double noise) { return std::max(5.0 * noise, map.cellSize()); };
-  if (again.epsilon == detection.config.epsilon && levelBand(again.noise) == levelBand(config.noise)) {
+  if (again.epsilon == config.epsilon && levelBand(again.noise) == levelBand(config.noise)) {
     detection.config.noise = again.noise;
     detection.stats.prior_noise = config.noise;
+    chargeNoise(detection, estimate_seconds);
     return detection;
   }
+  const double first_pass_seconds = secondsSince(start);
   detection = detectOnce(map, again, block_noise);
   detection.stats.prior_noise = config.noise;
-  // The first pass was the noise estimate.
-  detection.stats.stages.noise += first_pass_seconds;
-  detection.stats.direction_seconds += first_pass_seconds;
+  chargeNoise(detection, first_pass_seconds);
   return detection;
 }
 
