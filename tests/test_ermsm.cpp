@@ -169,6 +169,25 @@ TEST_CASE("eRMSM: a bench top two cells deep against a wall is a table at 10 cm 
   CHECK(top->area == doctest::Approx(2.0 * 0.2).epsilon(0.25));
 }
 
+TEST_CASE("eRMSM: a cabinet's 0.4 m ends are walls of their own at 10 cm cells") {
+  // Each end face holds three or four vertical blocks: as many fit points (a top and a
+  // bottom each) as six level blocks. Counted as blocks, both were dropped.
+  test::PlaneSceneBuilder scene(0.1);
+  scene.floor(0.0, 0.0, 4.0, 3.0, 0.0);
+  const double x0 = 1.03, x1 = 2.23, y0 = 1.03, y1 = 1.43, height = 1.5;
+  scene.wallY(y0, x0, x1, 0.0, height).wallY(y1, x0, x1, 0.0, height).floor(x0, y0, x1, y1, height);
+  scene.wallX(x0, y0, y1, 0.0, height).wallX(x1, y0, y1, 0.0, height);
+  const PlaneDetection detection = detectPlanes(scene.map());
+  for (const double x : {x0, x1}) {
+    CAPTURE(x);
+    const Plane* end = findPlane(detection, Eigen::Vector3d::UnitX(), -x);
+    REQUIRE(end != nullptr);
+    CHECK(angleDeg(end->normal, Eigen::Vector3d::UnitX()) < 2.0);
+    CHECK(std::abs(std::abs(end->offset) - x) < 0.02);
+    CHECK(end->area == doctest::Approx((y1 - y0) * height).epsilon(0.5));
+  }
+}
+
 namespace {
 
 std::vector<const Plane*> wallsFacingY(const PlaneDetection& detection) {

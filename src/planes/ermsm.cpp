@@ -274,7 +274,7 @@ bool Detector::accept(std::size_t index) {
   for (std::size_t k = 0; k < split.patches.size(); ++k) {
     Patch& patch = split.patches[k];
     if (patch.surface * cell_area < config_.min_patch_area ||
-        patch.blocks.size() < static_cast<std::size_t>(config_.min_patch_blocks) ||
+        fitPoints(grid_, patch) < static_cast<std::size_t>(config_.min_patch_blocks) ||
         isThin(grid_, patch, accepted.plane, min_width, patch_threads_)) {
       continue;
     }

@@ -86,6 +86,12 @@ double directionSpread(const BlockGrid& grid, const std::vector<Eigen::Vector3f>
   return weight > 0.0 ? weighted / weight * 180.0 / std::numbers::pi : 0.0;
 }
 
+std::size_t fitPoints(const BlockGrid& grid, const Patch& patch) {
+  std::size_t points = 0;
+  for (const std::uint32_t id : patch.blocks) points += grid.blocks()[id].vertical ? 2 : 1;
+  return points;
+}
+
 double medianDistance(const BlockGrid& grid, const std::vector<std::uint32_t>& ids, const CandidatePlane& plane) {
   if (ids.empty()) return 0.0;
   std::vector<float> distances;

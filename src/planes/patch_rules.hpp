@@ -50,6 +50,14 @@ inline double spreadLimit(double max_deg, double noise_deg) { return std::hypot(
 // neighbouring object pulls away.
 double medianDistance(const BlockGrid& grid, const std::vector<std::uint32_t>& ids, const CandidatePlane& plane);
 
+// The points a patch's plane is fitted to (PcaSums::addBlock): one per level block, two
+// per vertical block (its top and its bottom). A patch needs ErmsmConfig::min_patch_blocks
+// of them: a wall's face three cells wide is as well determined as a floor's six cells,
+// and counting blocks lost the 0.5 m ends of lockers and cabinets (1.2-1.8 m tall, three
+// vertical blocks at 10 cm cells) of the simulated corridor, and wall pieces between
+// doorways on real scans (issue 19).
+std::size_t fitPoints(const BlockGrid& grid, const Patch& patch);
+
 // A patch one cell wide is no surface: it is the fringe of a wall standing on a cell
 // boundary (stray points in the next column) or a line of clutter. True when its blocks
 // spread across the plane less than `min_width` (m, standard deviation) in some direction.

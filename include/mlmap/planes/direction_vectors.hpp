@@ -27,6 +27,10 @@ struct DirectionConfig {
   float height_tolerance = 0.08F; // m, horizontal neighbours must lie this close in height
   int max_radius = 0;             // cells, the widest window; <= radius: never wider
   double max_tilt = 0.0;          // rad, per axis; 0: never wider
+  // A wall block whose window holds a corner takes the line through itself that most of
+  // the window's blocks lie on (direction_vectors.cpp, cornerDirection); false: the
+  // principal axis of them all, as the paper's Fig. 4.
+  bool corners = true;
   int threads = 0;                // OpenMP threads; 0 = OpenMP's default
 };
 
