@@ -42,7 +42,7 @@ struct ErmsmConfig {
   double acceptance_exponent = 1.0;
   double min_area = 0.15;         // m², s_m: a plane's minimal matched surface
   double min_patch_area = 0.15;   // m², smaller connected patches go back to the pool
-  int min_patch_blocks = 6;       // blocks, and so do patches of fewer blocks
+  int min_patch_blocks = 6;       // fit points (a level block one, a vertical block two), and so do patches of fewer
   double min_patch_width_cells = 0.7;  // cells, and patches whose blocks spread less across (std-dev)
   // cells, the same for level patches: two rows of cells (a spread of 0.5) are enough. A
   // stair tread or a bench top against a wall is two cells deep at 10 cm cells; the
