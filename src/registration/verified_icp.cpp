@@ -225,6 +225,7 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
   if (!settled && config.retry) {
     // 2. The wide basin from the same start, then other starts about it.
     IcpConfig wide = icp;
+    wide.max_fine_distance = std::min(icp.max_fine_distance, icp.initial_max_distance);
     wide.initial_max_distance = std::max(
         icp.initial_max_distance,
         config.max_start_translation + std::min(kMaxYawReach, radius * radians(config.max_start_yaw_deg)));
