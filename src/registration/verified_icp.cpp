@@ -188,11 +188,14 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
     ++out.attempts;
     const Verification check = verify(result.pose);
     const double distance = distanceFrom(start, result.pose, radius);
-    // A later run replaces the first only when it is verified: among results that are
-    // not, the share of explained points misleads (a scan slid onto the target's sensor
-    // position explains more of itself: the target is densest there), and the first run
-    // is the plain ICP's answer.
-    if (!have || (verifiedCheck(check) && better(check, distance, out.check, kept_distance))) {
+    // A later run replaces the first when it is verified, or when it explains the overlap
+    // (share and spread) and the kept one does not; among results that do neither, the
+    // share of explained points misleads (a scan slid onto the target's sensor position
+    // explains more of itself: the target is densest there), and the first run is the
+    // plain ICP's answer.
+    const bool replaces = (verifiedCheck(check) && better(check, distance, out.check, kept_distance)) ||
+                          (check.good && !out.check.good);
+    if (!have || replaces) {
       kept_distance = distance;
       out.icp = result;
       out.check = check;
