@@ -104,6 +104,10 @@ int runIcpStarts(int argc, char** argv) {
         run["eigenvalue_ratio"] = result.check.eigenvalue_ratio;
         run["unconstrained"] = result.unconstrained;
         run["no_overlap"] = result.no_overlap;
+        run["slides"] = result.slides;
+        const SlideProfile& profile = result.check.profile;
+        run["profile"] = {{"facing", profile.facing}, {"at_result", profile.at_result}, {"away", profile.away},
+                          {"best", profile.best}, {"best_shift", profile.best_shift}, {"peaked", profile.peaked}};
       }
       const double icp_seconds = secondsSince(icp_start);
       run["seconds"] = {{"prepare", prep_seconds}, {"icp", icp_seconds}, {"total", prep_seconds + icp_seconds}};

@@ -272,7 +272,7 @@ IcpResult alignPoints(const std::vector<Point>& source, const VoxelHashMap& targ
       ++coarse_iterations;
       if (motion < kCoarseSettledMotion * config.min_max_distance || coarse_iterations >= kMaxCoarseIterations) {
         coarse = false;
-        gate = next_gate;
+        gate = std::max(config.min_max_distance, std::min(next_gate, config.max_fine_distance));
       }
       continue;
     }

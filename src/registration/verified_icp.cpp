@@ -1,5 +1,7 @@
 #include "mlmap/registration/verified_icp.hpp"
 
+#include "mlmap/registration/slide_profile.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -20,6 +22,9 @@ constexpr double kLevelNormal = 0.7071;
 // m, the most the start's yaw error adds to the first gate: a source far from its own
 // origin (a map 60 m away) would otherwise make every search visit thousands of voxels.
 constexpr double kMaxYawReach = 1.5;
+// The slide profile samples at most this many shifts (its step is 2σ, or coarser where that
+// is under a 50th of the range).
+constexpr double kMaxSlideSteps = 50.0;
 
 double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
@@ -57,12 +62,7 @@ double cloudRadius(const std::vector<Point>& source) {
 }  // namespace
 
 double cloudNoise(const std::vector<Point>& points, double voxel_size, double min_noise) {
-  // Every point kept (a down-sampled source has about one a voxel): the noise of these
-  // points, not of a sample of them.
-  VoxelHashMap cloud(voxel_size, std::numeric_limits<std::uint32_t>::max());
-  cloud.addPoints(points);
-  cloud.estimateNormals(NormalConfig{.radius = 2.0 * voxel_size});
-  return std::max(min_noise, cloud.surfaceNoise());
+  return std::max(min_noise, cloudSurfaces(points, voxel_size).noise);
 }
 
 Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& pose,
@@ -109,6 +109,7 @@ Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMa
     check.eigenvalue_ratio = largest > 0.0 ? std::max(0.0, solver.eigenvalues()[0]) / largest : 0.0;
   }
   check.constrained = check.eigenvalue_ratio >= config.min_eigenvalue_ratio;
+  check.translation_information = Matrix6d(hessian.selfadjointView<Eigen::Lower>()).bottomRightCorner<3, 3>();
   check.matched = matched.size();
   check.explained_share =
       source.empty() ? 0.0 : static_cast<double>(check.explained) / static_cast<double>(source.size());
@@ -154,26 +155,47 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
   }
   // The expected residual: both clouds carry their measured noise.
   out.noise = config.noise > 0.0 ? config.noise : std::max(config.min_noise, target.surfaceNoise());
-  out.source_noise =
-      config.source_noise > 0.0 ? config.source_noise : cloudNoise(source, target.voxelSize(), config.min_noise);
+  const CloudSurfaces surfaces = cloudSurfaces(source, target.voxelSize());
+  out.source_noise = config.source_noise > 0.0 ? config.source_noise : std::max(config.min_noise, surfaces.noise);
   const double sigma = std::hypot(out.noise, out.source_noise);
   // The verification gate reaches past a misalignment's residuals (so their spread shows)
   // but not past the ICP's own final gate.
   const double gate = std::max(icp.min_max_distance, 10.0 * sigma);
   const double radius = cloudRadius(source);
 
+  // The slide profile over the start's error bound about the start, in steps of 2σ: the
+  // peak is then sampled several times (it spans ±2·3σ / cos 30°).
+  const double bound = config.explained_sigmas * sigma;
+  const double step = std::max(2.0 * sigma, 2.0 * config.max_start_translation / kMaxSlideSteps);
+  const auto verify = [&](const Pose& pose) {
+    Verification check = verifyAlignment(source, target, pose, sigma, gate, config);
+    Eigen::Matrix3d information = check.translation_information;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(information);
+    const double along = (start.translation() - pose.translation()).dot(solver.eigenvectors().col(0));
+    check.profile = slideProfile(source, surfaces.normals, target, pose, information, bound,
+                                 along - config.max_start_translation, along + config.max_start_translation, step);
+    check.constrained = check.profile.peaked &&
+                        check.eigenvalue_ratio >= config.rotation_ratio_share * config.min_eigenvalue_ratio;
+    return check;
+  };
+
   bool have = false;
   double kept_distance = 0.0;
+  Pose last_pose = start;  // of the last run
   const auto attempt = [&](const Pose& from, const IcpConfig& run) {
     const IcpResult result = alignPoints(source, target, from, run);
+    last_pose = result.pose;
     ++out.attempts;
-    const Verification check = verifyAlignment(source, target, result.pose, sigma, gate, config);
+    const Verification check = verify(result.pose);
     const double distance = distanceFrom(start, result.pose, radius);
-    // A later run replaces the first only when it is verified: among results that are
-    // not, the share of explained points misleads (a scan slid onto the target's sensor
-    // position explains more of itself: the target is densest there), and the first run
-    // is the plain ICP's answer.
-    if (!have || (verifiedCheck(check) && better(check, distance, out.check, kept_distance))) {
+    // A later run replaces the first when it is verified, or when it explains the overlap
+    // (share and spread) and the kept one does not; among results that do neither, the
+    // share of explained points misleads (a scan slid onto the target's sensor position
+    // explains more of itself: the target is densest there), and the first run is the
+    // plain ICP's answer.
+    const bool replaces = (verifiedCheck(check) && better(check, distance, out.check, kept_distance)) ||
+                          (check.good && !out.check.good);
+    if (!have || replaces) {
       kept_distance = distance;
       out.icp = result;
       out.check = check;
@@ -183,8 +205,18 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
     return check;
   };
 
+  // A result the slide profile says is slid: one more run from where the profile peaks.
+  const auto slide = [&](const Verification& check, const IcpConfig& run) {
+    if (!check.profile.better_elsewhere) return check;
+    Pose from = last_pose;
+    from.translation() += check.profile.best_shift * check.profile.direction;
+    ++out.slides;
+    return attempt(from, run);
+  };
+
   // 1. One run as asked: most pairs end here, at the cost of the plain ICP and one check.
   const Verification first = attempt(start, icp);
+  const Verification slid = verifiedCheck(first) ? first : slide(first, icp);
   out.first_matched_share =
       static_cast<double>(first.matched) / static_cast<double>(std::max<std::size_t>(1, first.source_points));
   // A start within the basin of clouds that overlap leaves much of the source near the
@@ -192,10 +224,11 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
   out.no_overlap = out.first_matched_share < config.min_matched_share;
   // Explained but unconstrained: the free direction stays where the start put it (ICP
   // leaves it alone), and no other start can fix what the geometry does not measure.
-  const bool settled = verifiedCheck(first) || first.good || out.no_overlap;
+  const bool settled = verifiedCheck(slid) || first.good || slid.good || out.no_overlap;
   if (!settled && config.retry) {
     // 2. The wide basin from the same start, then other starts about it.
     IcpConfig wide = icp;
+    wide.max_fine_distance = std::min(icp.max_fine_distance, icp.initial_max_distance);
     wide.initial_max_distance = std::max(
         icp.initial_max_distance,
         config.max_start_translation + std::min(kMaxYawReach, radius * radians(config.max_start_yaw_deg)));
@@ -211,7 +244,8 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
       }
     }
     for (const Pose& from : starts) {
-      if (verifiedCheck(attempt(from, wide))) break;
+      const Verification check = attempt(from, wide);
+      if (verifiedCheck(check) || verifiedCheck(slide(check, wide))) break;
     }
   }
   out.verified = verifiedCheck(out.check);

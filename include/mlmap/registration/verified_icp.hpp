@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "mlmap/registration/icp.hpp"
+#include "mlmap/registration/slide_profile.hpp"
 #include "mlmap/registration/voxel_hash_map.hpp"
 #include "mlmap/scan.hpp"
 
@@ -44,6 +45,12 @@ struct BasinConfig {
   double min_explained_share = 0.5;    // of the matched points
   std::size_t min_matched = 100;       // IcpConfig::min_inliers
   double max_spread_ratio = 2.0;
+  // Constrained (alignVerified): the slide profile (slide_profile.hpp) peaks at the result
+  // along the weakest translation, over the start's error bound about the start, and the
+  // eigenvalue ratio below is at least rotation_ratio_share of its value (a rotation the
+  // geometry leaves free, which the profile does not test; the long corridor's true results
+  // reach 3e-3). verifyAlignment alone: the eigenvalue ratio.
+  double rotation_ratio_share = 0.1;
   // Constrained: λ_min / λ_max of the explained points' point-to-plane normal equations
   // (rotations scaled to metres at the cloud's RMS range) at least this. Measured on the
   // stress benchmark (tune split): results in the lab, the symmetric room, the generated
@@ -68,7 +75,9 @@ struct Verification {
   double spread = 0.0;         // m, robust (MAD) spread of the matched points' residuals
   double sigma = 0.0;          // m, the expected residual
   double eigenvalue_ratio = 0.0;  // λ_min/λ_max of the explained points' normal equations
-  bool constrained = false;    // eigenvalue_ratio >= min_eigenvalue_ratio
+  bool constrained = false;    // eigenvalue_ratio >= min_eigenvalue_ratio; alignVerified: see BasinConfig
+  Eigen::Matrix3d translation_information = Eigen::Matrix3d::Zero();  // Σ n nᵀ of the explained points
+  SlideProfile profile;        // alignVerified only
   bool good = false;           // explains the overlap (share and spread); see constrained
 };
 
@@ -80,6 +89,7 @@ struct VerifiedIcp {
   double noise = 0.0;          // m, the target noise used
   double source_noise = 0.0;   // m, the source noise used
   int attempts = 0;            // ICP runs (1: no retry)
+  int slides = 0;              // of them started where the slide profile peaked
   double first_matched_share = 0.0;  // of the first run: source points matched within the gate
   bool verified = false;       // explains the overlap and the geometry constrains every direction
   bool unconstrained = false;  // explains the overlap but leaves a direction free (a corridor)
