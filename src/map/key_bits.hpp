@@ -69,14 +69,26 @@ class KeyBits {
 
   // Inlined into the ray loop; the chunk change (one step in ~16) is not.
   [[gnu::always_inline]] void insert(unsigned x, unsigned y, unsigned z) {
-    const std::uint64_t chunk = (x >> kChunkBits) | (static_cast<std::uint64_t>(y >> kChunkBits) << 16) |
-                                (static_cast<std::uint64_t>(z >> kChunkBits) << 32);
+    const std::uint64_t chunk = chunkOf(x, y, z);
     if (chunk != cached_chunk_) [[unlikely]] switchChunk(chunk);
     const unsigned mask = (1U << kChunkBits) - 1;
     const unsigned bit = kInChunk[x & mask] | (kInChunk[y & mask] << 1) | (kInChunk[z & mask] << 2);
     (*cached_words_)[bit >> 6] |= std::uint64_t{1} << (bit & 63U);
   }
   void insert(const octomap::OcTreeKey& key) { insert(key[0], key[1], key[2]); }
+
+  // The words of the chunk holding key (x, y, z), added if new; valid until the next
+  // chunk is added. With bitInChunk, for callers that step through a chunk themselves.
+  ChunkWords& chunkWords(unsigned x, unsigned y, unsigned z) {
+    const std::uint64_t chunk = chunkOf(x, y, z);
+    if (chunk != cached_chunk_) switchChunk(chunk);
+    return *cached_words_;
+  }
+  // The Morton index of key (x, y, z) in its chunk.
+  static unsigned bitInChunk(unsigned x, unsigned y, unsigned z) {
+    const unsigned mask = (1U << kChunkBits) - 1;
+    return kInChunk[x & mask] | (kInChunk[y & mask] << 1) | (kInChunk[z & mask] << 2);
+  }
 
   // Empties the set, keeping its memory for the next scan.
   void clear() {
@@ -105,6 +117,12 @@ class KeyBits {
     for (unsigned v = 0; v < table.size(); ++v) table[v] = static_cast<unsigned>(spreadBits(v));
     return table;
   }();
+
+  // The chunk's coordinates, packed (the cache's key).
+  static std::uint64_t chunkOf(unsigned x, unsigned y, unsigned z) {
+    return (x >> kChunkBits) | (static_cast<std::uint64_t>(y >> kChunkBits) << 16) |
+           (static_cast<std::uint64_t>(z >> kChunkBits) << 32);
+  }
 
   [[gnu::noinline]] void switchChunk(std::uint64_t chunk) {
     cached_chunk_ = chunk;

@@ -37,6 +37,33 @@ int threadIndex() {
 #endif
 }
 
+// One axis of a ray's steps through the Morton index of a voxel in its chunk: the
+// axis's bits of the index (every third) form the voxel's coordinate in the chunk, and
+// a step adds or subtracts one there, leaving the other axes' bits.
+struct AxisStep {
+  AxisStep(unsigned axis, int step)
+      : key_step(static_cast<unsigned>(step)),
+        mask(static_cast<unsigned>(spreadBits((1U << kChunkBits) - 1)) << axis),
+        keep(step >= 0 ? ~0U : mask),
+        fill(step >= 0 ? ~mask : 0U),
+        add(step >= 0 ? 1U << axis : 0U - (1U << axis)),
+        leaves(step >= 0 ? mask : 0U) {}
+
+  // Steps the index; true when the step leaves the chunk (the coordinate wraps).
+  bool advance(unsigned& bit) const {
+    const bool wraps = (bit & mask) == leaves;
+    bit = ((((bit & keep) | fill) + add) & mask) | (bit & ~mask);
+    return wraps;
+  }
+
+  unsigned key_step;  // added to the key (mod 2^16)
+  unsigned mask;      // the axis's bits of the index
+  unsigned keep;      // +1: set the other bits so that the carry passes them;
+  unsigned fill;      // -1: clear them so that the borrow passes them
+  unsigned add;
+  unsigned leaves;    // the axis's bits at the chunk's last voxel in the step's direction
+};
+
 // OcTreeBaseImpl::computeRayKeys (Amanatides & Woo's DDA) step for step, with the same
 // float and double operations so that it visits the same voxels, into a KeyBits
 // instead of a KeyRay: the voxels from the origin's up to, not including, the end's.
@@ -70,37 +97,64 @@ void castRay(const octomap::OcTree& tree, const point3d& origin, const point3d& 
     }
   }
   // computeRayKeys' step with the three t and keys in registers instead of indexed
-  // arrays (a store and reload per step), the key comparison as one test and the
-  // key set's bit insert inlined: 1.6x the rays per second. The axis: 0 when t0 < t1
-  // and t0 < t2, 1 when t1 <= t0 and t1 < t2, else 2, the choices of its if/else.
-  // (Masks instead of branches were slower: the axis pattern along one ray predicts
-  // well.) Adding 0.0 leaves a t unchanged.
+  // arrays (a store and reload per step), one branch per axis choice (its if/else)
+  // so that a step adds to one t only, and the key set's bit insert inlined.
+  //
+  // Its test for the end voxel compares the whole key at every step. Each step moves
+  // one key component one voxel towards the end's side (the step signs are those of
+  // end - origin, and keys grow with the coordinate), so the end voxel can only be
+  // reached at step |Δk0| + |Δk1| + |Δk2|, the one step where the key is compared.
+  //
+  // The voxel's bit in its chunk is stepped along with the key (AxisStep) instead of
+  // computed from the key at every step; the chunk is looked up again only when a
+  // step leaves it.
   double t0 = t_max[0];
   double t1 = t_max[1];
   double t2 = t_max[2];
   unsigned k0 = key_origin[0];
   unsigned k1 = key_origin[1];
   unsigned k2 = key_origin[2];
-  const auto step0 = static_cast<unsigned>(step[0]);
-  const auto step1 = static_cast<unsigned>(step[1]);
-  const auto step2 = static_cast<unsigned>(step[2]);
+  const AxisStep axis0(0, step[0]);
+  const AxisStep axis1(1, step[1]);
+  const AxisStep axis2(2, step[2]);
+  const double delta0 = t_delta[0];
+  const double delta1 = t_delta[1];
+  const double delta2 = t_delta[2];
   const double length_d = length;
+  const auto distance = [](unsigned a, unsigned b) { return a > b ? a - b : b - a; };
+  auto to_end = static_cast<std::int64_t>(distance(k0, key_end[0]) + distance(k1, key_end[1]) +
+                                          distance(k2, key_end[2]));
+  unsigned bit = KeyBits::bitInChunk(k0, k1, k2);
+  ChunkWords* words = nullptr;  // the chunk of bit; null: look it up
   for (;;) {
-    const bool before_1 = t0 < t1;
-    const bool axis0 = before_1 && t0 < t2;
-    const bool axis1 = !before_1 && t1 < t2;
-    const bool axis2 = !axis0 && !axis1;
-    k0 = (k0 + (axis0 ? step0 : 0U)) & 0xFFFFU;  // key_type arithmetic
-    k1 = (k1 + (axis1 ? step1 : 0U)) & 0xFFFFU;
-    k2 = (k2 + (axis2 ? step2 : 0U)) & 0xFFFFU;
-    t0 += axis0 ? t_delta[0] : 0.0;
-    t1 += axis1 ? t_delta[1] : 0.0;
-    t2 += axis2 ? t_delta[2] : 0.0;
-    if (((k0 ^ key_end[0]) | (k1 ^ key_end[1]) | (k2 ^ key_end[2])) == 0) return;
+    bool left_chunk = false;
+    if (t0 < t1) {
+      if (t0 < t2) {
+        k0 = (k0 + axis0.key_step) & 0xFFFFU;  // key_type arithmetic
+        t0 += delta0;
+        left_chunk = axis0.advance(bit);
+      } else {
+        k2 = (k2 + axis2.key_step) & 0xFFFFU;
+        t2 += delta2;
+        left_chunk = axis2.advance(bit);
+      }
+    } else if (t1 < t2) {
+      k1 = (k1 + axis1.key_step) & 0xFFFFU;
+      t1 += delta1;
+      left_chunk = axis1.advance(bit);
+    } else {
+      k2 = (k2 + axis2.key_step) & 0xFFFFU;
+      t2 += delta2;
+      left_chunk = axis2.advance(bit);
+    }
+    if (left_chunk) words = nullptr;
+    if (--to_end == 0) {
+      if (k0 == key_end[0] && k1 == key_end[1] && k2 == key_end[2]) return;
+    }
     // Past the end's distance without meeting its voxel: rounding, stop as OctoMap does.
-    const double nearest01 = t1 < t0 ? t1 : t0;
-    if ((t2 < nearest01 ? t2 : nearest01) > length_d) return;
-    free.insert(k0, k1, k2);
+    if (std::min(std::min(t0, t1), t2) > length_d) return;
+    if (words == nullptr) [[unlikely]] words = &free.chunkWords(k0, k1, k2);
+    (*words)[bit >> 6U] |= std::uint64_t{1} << (bit & 63U);
   }
 }
 
@@ -223,6 +277,7 @@ void insertRays(octomap::OcTree& tree, const Scan& scan, const RayOptions& optio
         });
       }
     }
+
   }
   merge(free, buffers.merged_free);
   merge(hit, buffers.merged_hit);
