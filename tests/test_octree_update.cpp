@@ -144,6 +144,19 @@ TEST_CASE("OcTree update: one ray per end voxel equals OctoMap's discretized ins
   checkSameAsOctomap(0.07, 2.2, false);
 }
 
+TEST_CASE("OcTree update: rays along a voxel plane (a direction component exactly 0) as OctoMap casts them") {
+  // The scanner at a voxel centre: a ray to the centre of any end voxel in the same
+  // row, column or layer has a direction component of exactly 0 (step 0, t = DBL_MAX).
+  std::vector<Scan> scans{roomScan({0.05, 0.05, 1.25}, 0.0), roomScan({-0.95, 0.45, 0.75}, 0.2)};
+  MapConfig config;
+  config.cell_size = 0.1;
+  Map map(config);
+  for (const Scan& scan : scans) map.insertIntoOctree(scan);
+  const octomap::OcTree reference = octomapReference(scans, 0.1, -1.0, true);
+  CHECK(checkVoxelsIn(map.octree(), reference) == checkVoxelsIn(reference, map.octree()));
+  CHECK(map.octree().size() == reference.size());
+}
+
 TEST_CASE("OcTree update: exact rays equal OctoMap's per-point insertPointCloud voxel for voxel") {
   checkSameAsOctomap(0.1, -1.0, true);
   checkSameAsOctomap(0.07, 2.2, true);

@@ -39,30 +39,93 @@ int threadIndex() {
 
 // One axis of a ray's steps through the Morton index of a voxel in its chunk: the
 // axis's bits of the index (every third) form the voxel's coordinate in the chunk, and
-// a step adds or subtracts one there, leaving the other axes' bits.
+// a step adds or subtracts one there, leaving the other axes' bits. The step's sign is
+// a template argument so that the masks are constants, not registers the ray loop
+// runs short of.
+template <unsigned Axis, int Step>
 struct AxisStep {
-  AxisStep(unsigned axis, int step)
-      : key_step(static_cast<unsigned>(step)),
-        mask(static_cast<unsigned>(spreadBits((1U << kChunkBits) - 1)) << axis),
-        keep(step >= 0 ? ~0U : mask),
-        fill(step >= 0 ? ~mask : 0U),
-        add(step >= 0 ? 1U << axis : 0U - (1U << axis)),
-        leaves(step >= 0 ? mask : 0U) {}
+  static constexpr unsigned kMask = static_cast<unsigned>(spreadBits((1U << kChunkBits) - 1)) << Axis;
+  // +1: the other bits set so that the carry passes them; -1: cleared so that the borrow does
+  static constexpr unsigned kKeep = Step > 0 ? ~0U : kMask;
+  static constexpr unsigned kFill = Step > 0 ? ~kMask : 0U;
+  static constexpr unsigned kAdd = Step > 0 ? 1U << Axis : 0U - (1U << Axis);
+  static constexpr unsigned kLeaves = Step > 0 ? kMask : 0U;  // the chunk's last coordinate that way
+  static constexpr unsigned kKeyStep = static_cast<unsigned>(Step);
 
-  // Steps the index; true when the step leaves the chunk (the coordinate wraps).
-  bool advance(unsigned& bit) const {
-    const bool wraps = (bit & mask) == leaves;
-    bit = ((((bit & keep) | fill) + add) & mask) | (bit & ~mask);
+  // Steps the key and the index; true when the step leaves the chunk.
+  static bool advance(unsigned& key, unsigned& bit) {
+    key = (key + kKeyStep) & 0xFFFFU;  // key_type arithmetic
+    const bool wraps = (bit & kMask) == kLeaves;
+    bit = ((((bit & kKeep) | kFill) + kAdd) & kMask) | (bit & ~kMask);
     return wraps;
   }
-
-  unsigned key_step;  // added to the key (mod 2^16)
-  unsigned mask;      // the axis's bits of the index
-  unsigned keep;      // +1: set the other bits so that the carry passes them;
-  unsigned fill;      // -1: clear them so that the borrow passes them
-  unsigned add;
-  unsigned leaves;    // the axis's bits at the chunk's last voxel in the step's direction
 };
+
+struct RayStart {
+  std::array<unsigned, 3> key;
+  std::array<unsigned, 3> key_end;
+  std::array<double, 3> t_max;
+  std::array<double, 3> t_delta;
+  double length;
+};
+
+// computeRayKeys' incremental phase for one combination of step signs (an axis whose
+// step is 0 has t = DBL_MAX and is never chosen before the length test ends the ray;
+// it takes +1 here). The three t and keys are in registers instead of indexed arrays
+// (a store and reload per step), one branch per axis choice (its if/else) so that a
+// step adds to one t only, and the key set's bit insert is inlined.
+//
+// Its test for the end voxel compares the whole key at every step. Each step moves
+// one key component one voxel towards the end's side (the step signs are those of
+// end - origin, and keys grow with the coordinate), so the end voxel can only be
+// reached at step |Δk0| + |Δk1| + |Δk2|, the one step where the key is compared.
+//
+// The voxel's bit in its chunk is stepped along with the key instead of computed from
+// the key at every step; the chunk is looked up again only when a step leaves it.
+template <int S0, int S1, int S2>
+void stepRay(const RayStart& ray, KeyBits& free) {
+  double t0 = ray.t_max[0];
+  double t1 = ray.t_max[1];
+  double t2 = ray.t_max[2];
+  unsigned k0 = ray.key[0];
+  unsigned k1 = ray.key[1];
+  unsigned k2 = ray.key[2];
+  const double delta0 = ray.t_delta[0];
+  const double delta1 = ray.t_delta[1];
+  const double delta2 = ray.t_delta[2];
+  const double length = ray.length;
+  const auto distance = [](unsigned a, unsigned b) { return a > b ? a - b : b - a; };
+  auto to_end = static_cast<std::int64_t>(distance(k0, ray.key_end[0]) + distance(k1, ray.key_end[1]) +
+                                          distance(k2, ray.key_end[2]));
+  unsigned bit = KeyBits::bitInChunk(k0, k1, k2);
+  ChunkWords* words = nullptr;  // the chunk of bit; null: look it up
+  for (;;) {
+    bool left_chunk = false;
+    if (t0 < t1) {
+      if (t0 < t2) {
+        t0 += delta0;
+        left_chunk = AxisStep<0, S0>::advance(k0, bit);
+      } else {
+        t2 += delta2;
+        left_chunk = AxisStep<2, S2>::advance(k2, bit);
+      }
+    } else if (t1 < t2) {
+      t1 += delta1;
+      left_chunk = AxisStep<1, S1>::advance(k1, bit);
+    } else {
+      t2 += delta2;
+      left_chunk = AxisStep<2, S2>::advance(k2, bit);
+    }
+    if (left_chunk) words = nullptr;
+    if (--to_end == 0) [[unlikely]] {
+      if (k0 == ray.key_end[0] && k1 == ray.key_end[1] && k2 == ray.key_end[2]) return;
+    }
+    // Past the end's distance without meeting its voxel: rounding, stop as OctoMap does.
+    if (std::min(std::min(t0, t1), t2) > length) return;
+    if (words == nullptr) [[unlikely]] words = &free.chunkWords(k0, k1, k2);
+    (*words)[bit >> 6U] |= std::uint64_t{1} << (bit & 63U);
+  }
+}
 
 // OcTreeBaseImpl::computeRayKeys (Amanatides & Woo's DDA) step for step, with the same
 // float and double operations so that it visits the same voxels, into a KeyBits
@@ -96,65 +159,20 @@ void castRay(const octomap::OcTree& tree, const point3d& origin, const point3d& 
       t_delta[i] = std::numeric_limits<double>::max();
     }
   }
-  // computeRayKeys' step with the three t and keys in registers instead of indexed
-  // arrays (a store and reload per step), one branch per axis choice (its if/else)
-  // so that a step adds to one t only, and the key set's bit insert inlined.
-  //
-  // Its test for the end voxel compares the whole key at every step. Each step moves
-  // one key component one voxel towards the end's side (the step signs are those of
-  // end - origin, and keys grow with the coordinate), so the end voxel can only be
-  // reached at step |Δk0| + |Δk1| + |Δk2|, the one step where the key is compared.
-  //
-  // The voxel's bit in its chunk is stepped along with the key (AxisStep) instead of
-  // computed from the key at every step; the chunk is looked up again only when a
-  // step leaves it.
-  double t0 = t_max[0];
-  double t1 = t_max[1];
-  double t2 = t_max[2];
-  unsigned k0 = key_origin[0];
-  unsigned k1 = key_origin[1];
-  unsigned k2 = key_origin[2];
-  const AxisStep axis0(0, step[0]);
-  const AxisStep axis1(1, step[1]);
-  const AxisStep axis2(2, step[2]);
-  const double delta0 = t_delta[0];
-  const double delta1 = t_delta[1];
-  const double delta2 = t_delta[2];
-  const double length_d = length;
-  const auto distance = [](unsigned a, unsigned b) { return a > b ? a - b : b - a; };
-  auto to_end = static_cast<std::int64_t>(distance(k0, key_end[0]) + distance(k1, key_end[1]) +
-                                          distance(k2, key_end[2]));
-  unsigned bit = KeyBits::bitInChunk(k0, k1, k2);
-  ChunkWords* words = nullptr;  // the chunk of bit; null: look it up
-  for (;;) {
-    bool left_chunk = false;
-    if (t0 < t1) {
-      if (t0 < t2) {
-        k0 = (k0 + axis0.key_step) & 0xFFFFU;  // key_type arithmetic
-        t0 += delta0;
-        left_chunk = axis0.advance(bit);
-      } else {
-        k2 = (k2 + axis2.key_step) & 0xFFFFU;
-        t2 += delta2;
-        left_chunk = axis2.advance(bit);
-      }
-    } else if (t1 < t2) {
-      k1 = (k1 + axis1.key_step) & 0xFFFFU;
-      t1 += delta1;
-      left_chunk = axis1.advance(bit);
-    } else {
-      k2 = (k2 + axis2.key_step) & 0xFFFFU;
-      t2 += delta2;
-      left_chunk = axis2.advance(bit);
-    }
-    if (left_chunk) words = nullptr;
-    if (--to_end == 0) {
-      if (k0 == key_end[0] && k1 == key_end[1] && k2 == key_end[2]) return;
-    }
-    // Past the end's distance without meeting its voxel: rounding, stop as OctoMap does.
-    if (std::min(std::min(t0, t1), t2) > length_d) return;
-    if (words == nullptr) [[unlikely]] words = &free.chunkWords(k0, k1, k2);
-    (*words)[bit >> 6U] |= std::uint64_t{1} << (bit & 63U);
+  const RayStart ray{{key_origin[0], key_origin[1], key_origin[2]},
+                     {key_end[0], key_end[1], key_end[2]},
+                     t_max,
+                     t_delta,
+                     length};
+  switch ((step[0] < 0 ? 1 : 0) | (step[1] < 0 ? 2 : 0) | (step[2] < 0 ? 4 : 0)) {
+    case 0: stepRay<1, 1, 1>(ray, free); break;
+    case 1: stepRay<-1, 1, 1>(ray, free); break;
+    case 2: stepRay<1, -1, 1>(ray, free); break;
+    case 3: stepRay<-1, -1, 1>(ray, free); break;
+    case 4: stepRay<1, 1, -1>(ray, free); break;
+    case 5: stepRay<-1, 1, -1>(ray, free); break;
+    case 6: stepRay<1, -1, -1>(ray, free); break;
+    default: stepRay<-1, -1, -1>(ray, free); break;
   }
 }
 
