@@ -15,6 +15,7 @@
 #include "crc32.hpp"
 #include "file_bytes.hpp"
 #include "mlmap/error.hpp"
+#include "mlmap/io/atomic_file.hpp"
 #include "mlmap/io/planes_json.hpp"
 
 namespace mlmap::io {
@@ -126,14 +127,24 @@ void writeMap(const std::filesystem::path& path, const Map& map) {
     octree_bytes = std::move(stream).str();
   }
   put<std::uint64_t>(out, octree_bytes.size());
-  out += octree_bytes;
+  // The sections are written one after another, the checksum taken across them,
+  // instead of appending the OcTree's tens of megabytes to `out` first (a copy into
+  // freshly faulted memory).
+  std::string tail;
   if (map.planes()) {
     const std::string planes = planesJson(map, *map.planes(), path.filename().string());
-    put<std::uint64_t>(out, planes.size());
-    out += planes;
+    put<std::uint64_t>(tail, planes.size());
+    tail += planes;
   }
-  put<std::uint32_t>(out, crc32(out.data(), out.size()));
-  writeWholeFile(path, out);
+  std::uint32_t crc = crc32(out.data(), out.size());
+  crc = crc32(octree_bytes.data(), octree_bytes.size(), crc);
+  crc = crc32(tail.data(), tail.size(), crc);
+  put<std::uint32_t>(tail, crc);
+  writeAtomically(path, [&](std::ostream& stream) {
+    for (const std::string* section : {&out, &octree_bytes, &tail}) {
+      stream.write(section->data(), static_cast<std::streamsize>(section->size()));
+    }
+  });
 }
 
 namespace {
