@@ -17,7 +17,7 @@ int runInfo(const std::string& path, bool as_json) {
   // The OcTree section is counted, not built: a large map's tree took seconds to allocate.
   const io::MapSummary summary = io::readMapSummary(path);
   const Map& map = summary.map;
-  const MLMapStats stats = map.blocks().stats();
+  const MLMapStats& stats = summary.blocks;
   nlohmann::json info;
   info["file"] = path;
   info["file_bytes"] = std::filesystem::file_size(path);

@@ -7,7 +7,8 @@
 Simulates the scene (true poses), then per resolution runs, in alternating rounds, each
 under /usr/bin/time -v:
   mlmap     `mlmap_bench octree`: Map::insertIntoOctree alone (one ray per end voxel,
-            OctoMap's discretized semantics), all OpenMP threads;
+            OctoMap's discretized semantics), all OpenMP threads, waiting passively as
+            the CLI does (OMP_WAIT_POLICY=passive unless set: apps/passive_wait.cpp);
   mlmap-1t  the same on one thread (OMP_NUM_THREADS=1);
   octomap   ../shared/peers' octomap_insert --discrete (insertPointCloud, discretize=true);
   bonxai    ../shared/peers' bonxai_insert (ProbabilisticMap, one ray per end voxel).
@@ -58,12 +59,14 @@ def main():
             peers[name] = path
         else:
             print(f"({name} not built in {args.peers}: left out)")
-    one_thread = dict(os.environ, OMP_NUM_THREADS="1")
+    passive = dict(os.environ)
+    passive.setdefault("OMP_WAIT_POLICY", "passive")
+    one_thread = dict(passive, OMP_NUM_THREADS="1")
     print(f"{args.scene}: {len(scans)} scans; load average {os.getloadavg()[0]:.1f} "
           f"on {os.cpu_count()} CPUs at the start")
     for res in [float(r) for r in args.resolutions.split(",")]:
         programs = {
-            "mlmap": ([bench, "octree", "--poses", poses, "--resolution", str(res)] + scans, None),
+            "mlmap": ([bench, "octree", "--poses", poses, "--resolution", str(res)] + scans, passive),
             "mlmap-1t": ([bench, "octree", "--poses", poses, "--resolution", str(res)] + scans, one_thread),
         }
         if "octomap_insert" in peers:

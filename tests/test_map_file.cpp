@@ -226,7 +226,7 @@ TEST_CASE("MapFile: the summary counts the OcTree section as the built tree repo
   io::writeMap(dir / "room.mlmap", map);
   const io::MapSummary summary = io::readMapSummary(dir / "room.mlmap");
   CHECK_FALSE(summary.map.hasOctree());
-  CHECK(summary.map.blocks().blockCount() == map.blocks().blockCount());
+  CHECK(summary.map.blocks().blockCount() == 0);  // counted, not restored
   REQUIRE(summary.octree.has_value());
   const octomap::OcTree& tree = map.octree();
   std::size_t occupied = 0;
@@ -238,6 +238,26 @@ TEST_CASE("MapFile: the summary counts the OcTree section as the built tree repo
   CHECK(summary.octree->memory_bytes == tree.memoryUsage());
   io::writeMap(dir / "blocks.mlmap", smallRoomMap(false));
   CHECK_FALSE(io::readMapSummary(dir / "blocks.mlmap").octree.has_value());
+}
+
+TEST_CASE("MapFile: the summary counts the blocks as the restored map's stats() reports them") {
+  test::TempDir dir;
+  Map map = smallRoomMap(false);
+  map.blocks().mutableBlocksAt(0)[0].plane = 3;  // one labelled block
+  io::writeMap(dir / "room.mlmap", map);
+  const MLMapStats restored = io::readMap(dir / "room.mlmap").blocks().stats();
+  const MLMapStats counted = io::readMapSummary(dir / "room.mlmap").blocks;
+  REQUIRE(restored.blocks > 100);
+  CHECK(counted.cells == restored.cells);
+  CHECK(counted.blocks == restored.blocks);
+  CHECK(counted.horizontal_blocks == restored.horizontal_blocks);
+  CHECK(counted.vertical_blocks == restored.vertical_blocks);
+  CHECK(counted.labelled_blocks == restored.labelled_blocks);
+  CHECK(counted.labelled_blocks == 1);
+  CHECK(counted.memory_bytes == restored.memory_bytes);
+  CHECK(counted.min == restored.min);
+  CHECK(counted.max == restored.max);
+  CHECK(restored.vertical_blocks > 0);
 }
 
 TEST_CASE("MapFile: the summary refuses a damaged OcTree section that the checksum covers") {

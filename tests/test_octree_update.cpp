@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "../src/map/octree_update.hpp"
+#include "../src/map/octree_walk.hpp"
 #include "mlmap/map/map.hpp"
 
 #ifdef _OPENMP
@@ -143,6 +144,19 @@ TEST_CASE("OcTree update: one ray per end voxel equals OctoMap's discretized ins
   checkSameAsOctomap(0.07, 2.2, false);
 }
 
+TEST_CASE("OcTree update: rays along a voxel plane (a direction component exactly 0) as OctoMap casts them") {
+  // The scanner at a voxel centre: a ray to the centre of any end voxel in the same
+  // row, column or layer has a direction component of exactly 0 (step 0, t = DBL_MAX).
+  std::vector<Scan> scans{roomScan({0.05, 0.05, 1.25}, 0.0), roomScan({-0.95, 0.45, 0.75}, 0.2)};
+  MapConfig config;
+  config.cell_size = 0.1;
+  Map map(config);
+  for (const Scan& scan : scans) map.insertIntoOctree(scan);
+  const octomap::OcTree reference = octomapReference(scans, 0.1, -1.0, true);
+  CHECK(checkVoxelsIn(map.octree(), reference) == checkVoxelsIn(reference, map.octree()));
+  CHECK(map.octree().size() == reference.size());
+}
+
 TEST_CASE("OcTree update: exact rays equal OctoMap's per-point insertPointCloud voxel for voxel") {
   checkSameAsOctomap(0.1, -1.0, true);
   checkSameAsOctomap(0.07, 2.2, true);
@@ -226,5 +240,87 @@ TEST_CASE("OcTree update: a pruned node above the split depth is expanded as Oct
     saturateBlock(tree);
     insertSplit(tree, scans, split);
     checkSameTrees(tree, reference);
+  }
+}
+
+namespace {
+
+using octomap::OcTreeKey;
+
+OcTreeKey keyAt(unsigned x, unsigned y, unsigned z) {
+  return OcTreeKey(static_cast<octomap::key_type>(x), static_cast<octomap::key_type>(y),
+                   static_cast<octomap::key_type>(z));
+}
+
+// Calls visit(key) for every key of the box [low, low + size) (size voxels a side).
+template <typename Visit>
+void forBox(unsigned x0, unsigned y0, unsigned z0, unsigned size, Visit&& visit) {
+  for (unsigned x = x0; x < x0 + size; ++x) {
+    for (unsigned y = y0; y < y0 + size; ++y) {
+      for (unsigned z = z0; z < z0 + size; ++z) visit(keyAt(x, y, z));
+    }
+  }
+}
+
+// A tree with pruned leaves at depths 11 and 12: saturated free, once missed, saturated occupied.
+void prunedBlocks(octomap::OcTree& tree) {
+  forBox(32768, 32768, 32768, 32, [&](const OcTreeKey& key) { tree.setNodeValue(key, tree.getClampingThresMinLog(), true); });
+  forBox(32800, 32768, 32768, 16, [&](const OcTreeKey& key) { tree.setNodeValue(key, tree.getProbMissLog(), true); });
+  forBox(32768, 32800, 32768, 16, [&](const OcTreeKey& key) { tree.setNodeValue(key, tree.getClampingThresMaxLog(), true); });
+  tree.updateInnerOccupancy();
+  tree.prune();
+}
+
+}  // namespace
+
+TEST_CASE("OcTree update: nodes whose voxels all take the same update end as OctoMap's voxel-by-voxel update") {
+  // The scan's voxels: whole pruned nodes alike (saturated and not, free and hit),
+  // new nodes alike (a 16³ chunk, 8 chunks of a depth-11 node, 8-voxel groups), and
+  // nodes almost alike (one voxel hit, one chunk of eight missing).
+  std::vector<OcTreeKey> free;
+  std::vector<OcTreeKey> hit;
+  const auto add = [](std::vector<OcTreeKey>& keys) { return [&keys](const OcTreeKey& key) { keys.push_back(key); }; };
+  forBox(32768, 32768, 32768, 32, add(free));   // the saturated free block: left as it is
+  forBox(32800, 32768, 32768, 16, add(free));   // the once-missed block: missed again
+  forBox(32768, 32800, 32768, 16, add(hit));    // the saturated occupied block: hit
+  forBox(32768, 32768, 32800, 32, add(free));   // new: a whole depth-11 node
+  forBox(32832, 32768, 32768, 16, add(hit));    // new: a whole chunk hit
+  forBox(32832, 32800, 32768, 16, add(free));   // new: a chunk all free but one voxel hit
+  hit.push_back(keyAt(32835, 32805, 32770));
+  forBox(32768, 32832, 32768, 32, [&](const OcTreeKey& key) {  // new: 7 of the 8 chunks of a depth-11 node
+    if (!(key[0] >= 32784 && key[1] >= 32848 && key[2] >= 32784)) free.push_back(key);
+  });
+  forBox(32864, 32864, 32864, 2, add(free));    // new: one depth-15 node
+  forBox(32866, 32864, 32864, 4, add(hit));     // new: a depth-14 node
+  free.push_back(keyAt(32870, 32864, 32864));   // and a lone voxel
+
+  octomap::OcTree reference(0.05);
+  prunedBlocks(reference);
+  // insertPointCloud's order: free (those not hit), then hit
+  const octomap::KeySet hit_set(hit.begin(), hit.end());
+  for (const OcTreeKey& key : free) {
+    if (hit_set.count(key) == 0) reference.updateNode(key, false);
+  }
+  for (const OcTreeKey& key : hit) reference.updateNode(key, true);
+
+  detail::KeyBits free_bits;
+  detail::KeyBits hit_bits;
+  for (const OcTreeKey& key : free) free_bits.insert(key);
+  for (const OcTreeKey& key : hit) hit_bits.insert(key);
+  std::vector<std::uint64_t> codes = free_bits.chunkCodes();
+  codes.insert(codes.end(), hit_bits.chunkCodes().begin(), hit_bits.chunkCodes().end());
+  std::sort(codes.begin(), codes.end());
+  codes.erase(std::unique(codes.begin(), codes.end()), codes.end());
+  std::vector<detail::ChunkUpdate> chunks;
+  for (const std::uint64_t code : codes) chunks.push_back({code, free_bits.find(code), hit_bits.find(code)});
+
+  for (const unsigned split : {0U, 12U, 9U}) {  // chosen, the chunks' depth, above the pruned leaves
+    CAPTURE(split);
+    octomap::OcTree tree(0.05);
+    prunedBlocks(tree);
+    detail::updateTree(tree, chunks, split);
+    checkSameTrees(tree, reference);
+    CHECK(tree.search(keyAt(32770, 32770, 32770))->getLogOdds() == tree.getClampingThresMinLog());
+    CHECK(tree.search(keyAt(32770, 32770, 32800)) == tree.search(keyAt(32770, 32770, 32800), 11));  // one leaf
   }
 }

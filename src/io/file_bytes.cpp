@@ -1,5 +1,10 @@
 #include "file_bytes.hpp"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include "mlmap/error.hpp"
 #include "mlmap/io/atomic_file.hpp"
 
@@ -15,6 +20,31 @@ std::string readWholeFile(const std::filesystem::path& path) {
   std::string bytes(static_cast<std::size_t>(size), '\0');
   if (!in.read(bytes.data(), size)) throw Error(path.string() + ": read failed");
   return bytes;
+}
+
+MappedFile::MappedFile(const std::filesystem::path& path) {
+  requireRegularFile(path);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw Error(path.string() + ": cannot open file");
+  struct stat info {};
+  if (::fstat(fd, &info) != 0 || info.st_size < 0) {
+    ::close(fd);
+    throw Error(path.string() + ": cannot determine file size");
+  }
+  size_ = static_cast<std::size_t>(info.st_size);
+  if (size_ > 0) {
+    void* mapped = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
+    if (mapped == MAP_FAILED) {
+      ::close(fd);
+      throw Error(path.string() + ": read failed (cannot map the file)");
+    }
+    data_ = static_cast<const char*>(mapped);
+  }
+  ::close(fd);  // the mapping keeps the file
+}
+
+MappedFile::~MappedFile() {
+  if (data_ != nullptr) ::munmap(const_cast<char*>(data_), size_);
 }
 
 void requireRegularFile(const std::filesystem::path& path) {

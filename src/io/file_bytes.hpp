@@ -11,6 +11,7 @@
 #include <istream>
 #include <streambuf>
 #include <string>
+#include <string_view>
 #include <utility>
 
 namespace mlmap::io {
@@ -26,6 +27,24 @@ std::ifstream openForReading(const std::filesystem::path& path);
 
 // writeAtomically with `bytes` as the whole content.
 void writeWholeFile(const std::filesystem::path& path, const std::string& bytes);
+
+// A file's bytes mapped read-only (no copy, and pages come from the page cache as they
+// are read): a 40 MB map took 0.2 s to read() into a zeroed string on this VM. mlmap
+// replaces files by rename (writeAtomically), never truncating one in place, which is
+// what would fault a reader of a mapping.
+class MappedFile {
+ public:
+  explicit MappedFile(const std::filesystem::path& path);  // mlmap::Error as readWholeFile
+  ~MappedFile();
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+
+  std::string_view bytes() const { return {data_, size_}; }
+
+ private:
+  const char* data_ = nullptr;
+  std::size_t size_ = 0;
+};
 
 // A file read whole, with an istream over its bytes (no copy) for a text header
 // followed by a binary body.

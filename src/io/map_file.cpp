@@ -3,6 +3,7 @@
 #include <bit>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -14,6 +15,7 @@
 #include "crc32.hpp"
 #include "file_bytes.hpp"
 #include "mlmap/error.hpp"
+#include "mlmap/io/atomic_file.hpp"
 #include "mlmap/io/planes_json.hpp"
 
 namespace mlmap::io {
@@ -42,7 +44,7 @@ void put(std::string& out, T value) {
 // the file and the byte offset where it happened.
 class ByteReader {
  public:
-  ByteReader(const std::string& bytes, std::size_t end, std::string name)
+  ByteReader(std::string_view bytes, std::size_t end, std::string name)
       : bytes_(bytes), end_(end), name_(std::move(name)) {}
 
   template <typename T>
@@ -73,7 +75,7 @@ class ByteReader {
   }
 
  private:
-  const std::string& bytes_;
+  std::string_view bytes_;
   std::size_t end_;
   std::string name_;
   std::size_t offset_ = 0;
@@ -125,22 +127,57 @@ void writeMap(const std::filesystem::path& path, const Map& map) {
     octree_bytes = std::move(stream).str();
   }
   put<std::uint64_t>(out, octree_bytes.size());
-  out += octree_bytes;
+  // The sections are written one after another, the checksum taken across them,
+  // instead of appending the OcTree's tens of megabytes to `out` first (a copy into
+  // freshly faulted memory).
+  std::string tail;
   if (map.planes()) {
     const std::string planes = planesJson(map, *map.planes(), path.filename().string());
-    put<std::uint64_t>(out, planes.size());
-    out += planes;
+    put<std::uint64_t>(tail, planes.size());
+    tail += planes;
   }
-  put<std::uint32_t>(out, crc32(out.data(), out.size()));
-  writeWholeFile(path, out);
+  std::uint32_t crc = crc32(out.data(), out.size());
+  crc = crc32(octree_bytes.data(), octree_bytes.size(), crc);
+  crc = crc32(tail.data(), tail.size(), crc);
+  put<std::uint32_t>(tail, crc);
+  writeAtomically(path, [&](std::ostream& stream) {
+    for (const std::string* section : {&out, &octree_bytes, &tail}) {
+      stream.write(section->data(), static_cast<std::streamsize>(section->size()));
+    }
+  });
 }
 
 namespace {
 
-// Reads the whole file; with `summary`, the OcTree section is only counted into it and
-// the map returned has no OcTree.
-Map readMapFile(const std::filesystem::path& path, std::optional<OctreeSummary>* summary) {
-  const std::string bytes = readWholeFile(path);
+// The block layer's figures (MLMap::stats) from one cell's blocks as the file holds
+// them, without restoring them.
+void countBlocks(MLMapStats& stats, const CellIndex& cell, const std::vector<Block>& blocks, double cell_size) {
+  if (blocks.empty()) return;
+  if (stats.blocks == 0) {
+    stats.min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    stats.max = -stats.min;
+  }
+  ++stats.cells;
+  stats.blocks += blocks.size();
+  for (const Block& block : blocks) {
+    (block.isVertical() ? stats.vertical_blocks : stats.horizontal_blocks)++;
+    if (block.plane != 0) ++stats.labelled_blocks;
+    stats.min.z() = std::min<double>(stats.min.z(), block.bottom());
+    stats.max.z() = std::max<double>(stats.max.z(), block.height);
+  }
+  stats.min.x() = std::min(stats.min.x(), cell.j * cell_size);
+  stats.min.y() = std::min(stats.min.y(), cell.i * cell_size);
+  stats.max.x() = std::max(stats.max.x(), (cell.j + 1) * cell_size);
+  stats.max.y() = std::max(stats.max.y(), (cell.i + 1) * cell_size);
+}
+
+// Reads the whole file; with `summary`, the OcTree section is only counted into
+// summary->octree, the blocks only into summary->blocks (the returned map has neither:
+// `mlmap info` on a 40 MB map took 0.4 s restoring them). The summary checks what the
+// reader checks of the file's structure and checksum, not each block's values.
+Map readMapFile(const std::filesystem::path& path, MapSummary* summary) {
+  const MappedFile file(path);
+  const std::string_view bytes = file.bytes();
   const std::string name = path.string();
   if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
     throw Error(name + ": byte 0: not an .mlmap file (bad magic number)");
@@ -188,6 +225,7 @@ Map readMapFile(const std::filesystem::path& path, std::optional<OctreeSummary>*
     in.fail("the header claims " + std::to_string(cell_count) + " cells and " +
             std::to_string(block_count) + " blocks, more than the file holds");
   }
+  if (summary == nullptr) map.blocks().reserve(cell_count, block_count);
   std::vector<Block> cell_blocks;
   std::uint64_t blocks_seen = 0;
   for (std::uint64_t c = 0; c < cell_count; ++c) {
@@ -214,6 +252,10 @@ Map readMapFile(const std::filesystem::path& path, std::optional<OctreeSummary>*
       }
     }
     blocks_seen += count;
+    if (summary != nullptr) {
+      countBlocks(summary->blocks, cell, cell_blocks, config.cell_size);
+      continue;
+    }
     try {
       map.blocks().restoreCell(cell, cell_blocks);
     } catch (const Error& error) {
@@ -232,7 +274,7 @@ Map readMapFile(const std::filesystem::path& path, std::optional<OctreeSummary>*
   if (config.with_octree && summary != nullptr) {
     const std::size_t octree_offset = in.offset();
     try {
-      *summary = summarizeOctree(in.take(octree_size, "the OcTree"));
+      summary->octree = summarizeOctree(in.take(octree_size, "the OcTree"));
     } catch (const Error& error) {
       in.failAt(octree_offset, error.what());
     }
@@ -277,9 +319,10 @@ Map readMapFile(const std::filesystem::path& path, std::optional<OctreeSummary>*
 Map readMap(const std::filesystem::path& path) { return readMapFile(path, nullptr); }
 
 MapSummary readMapSummary(const std::filesystem::path& path) {
-  std::optional<OctreeSummary> octree;
-  Map map = readMapFile(path, &octree);
-  return {std::move(map), octree};
+  MapSummary summary{Map(MapConfig{}), std::nullopt, MLMapStats{}};
+  summary.map = readMapFile(path, &summary);
+  summary.blocks.memory_bytes = MLMap::packedMemoryBytes(summary.blocks.cells, summary.blocks.blocks);
+  return summary;
 }
 
 }  // namespace mlmap::io

@@ -69,14 +69,26 @@ class KeyBits {
 
   // Inlined into the ray loop; the chunk change (one step in ~16) is not.
   [[gnu::always_inline]] void insert(unsigned x, unsigned y, unsigned z) {
-    const std::uint64_t chunk = (x >> kChunkBits) | (static_cast<std::uint64_t>(y >> kChunkBits) << 16) |
-                                (static_cast<std::uint64_t>(z >> kChunkBits) << 32);
+    const std::uint64_t chunk = chunkOf(x, y, z);
     if (chunk != cached_chunk_) [[unlikely]] switchChunk(chunk);
     const unsigned mask = (1U << kChunkBits) - 1;
     const unsigned bit = kInChunk[x & mask] | (kInChunk[y & mask] << 1) | (kInChunk[z & mask] << 2);
     (*cached_words_)[bit >> 6] |= std::uint64_t{1} << (bit & 63U);
   }
   void insert(const octomap::OcTreeKey& key) { insert(key[0], key[1], key[2]); }
+
+  // The words of the chunk holding key (x, y, z), added if new; valid until the next
+  // chunk is added. With bitInChunk, for callers that step through a chunk themselves.
+  ChunkWords& chunkWords(unsigned x, unsigned y, unsigned z) {
+    const std::uint64_t chunk = chunkOf(x, y, z);
+    if (chunk != cached_chunk_) switchChunk(chunk);
+    return *cached_words_;
+  }
+  // The Morton index of key (x, y, z) in its chunk.
+  static unsigned bitInChunk(unsigned x, unsigned y, unsigned z) {
+    const unsigned mask = (1U << kChunkBits) - 1;
+    return kInChunk[x & mask] | (kInChunk[y & mask] << 1) | (kInChunk[z & mask] << 2);
+  }
 
   // Empties the set, keeping its memory for the next scan.
   void clear() {
@@ -92,10 +104,11 @@ class KeyBits {
   const ChunkWords& chunkAt(std::size_t index) const { return words_[index]; }
   // The words of the chunk with this code, or nullptr.
   const ChunkWords* find(std::uint64_t code) const {
+    const std::uint64_t chunk = compactBits(code) | (compactBits(code >> 1) << 16) | (compactBits(code >> 2) << 32);
     const std::size_t mask = slots_.size() - 1;
-    for (std::size_t s = hashOf(code) & mask;; s = (s + 1) & mask) {
+    for (std::size_t s = hashOf(chunk) & mask;; s = (s + 1) & mask) {
       if (slots_[s] == 0) return nullptr;
-      if (slots_[s] == code + 1) return &words_[slot_index_[s]];
+      if (slots_[s] == chunk + 1) return &words_[slot_index_[s]];
     }
   }
 
@@ -106,50 +119,60 @@ class KeyBits {
     return table;
   }();
 
+  // The chunk's coordinates, packed (the cache's key).
+  static std::uint64_t chunkOf(unsigned x, unsigned y, unsigned z) {
+    return (x >> kChunkBits) | (static_cast<std::uint64_t>(y >> kChunkBits) << 16) |
+           (static_cast<std::uint64_t>(z >> kChunkBits) << 32);
+  }
+
+  // The table is keyed by the packed chunk coordinates, the key the cache compares,
+  // so that a chunk change (one per ~10 ray steps) spreads no bits; a chunk's Morton
+  // code is computed once, when it is added.
   [[gnu::noinline]] void switchChunk(std::uint64_t chunk) {
     cached_chunk_ = chunk;
-    const std::uint64_t x = chunk & 0xFFFFU;
-    const std::uint64_t y = (chunk >> 16) & 0xFFFFU;
-    const std::uint64_t z = chunk >> 32;
-    cached_words_ = &words_[chunkIndex(spreadBits(x) | (spreadBits(y) << 1) | (spreadBits(z) << 2))];
+    cached_words_ = &words_[chunkIndex(chunk)];
   }
 
-  static std::size_t hashOf(std::uint64_t code) {
-    return static_cast<std::size_t>((code * 0x9E3779B97F4A7C15ULL) >> 20);
+  static std::size_t hashOf(std::uint64_t chunk) {
+    return static_cast<std::size_t>((chunk * 0x9E3779B97F4A7C15ULL) >> 40);
   }
 
-  std::size_t chunkIndex(std::uint64_t code) {
+  std::size_t chunkIndex(std::uint64_t chunk) {
     std::size_t mask = slots_.size() - 1;
-    for (std::size_t s = hashOf(code) & mask;; s = (s + 1) & mask) {
-      if (slots_[s] == code + 1) return slot_index_[s];
+    for (std::size_t s = hashOf(chunk) & mask;; s = (s + 1) & mask) {
+      if (slots_[s] == chunk + 1) return slot_index_[s];
       if (slots_[s] != 0) continue;
       if (2 * (codes_.size() + 1) > slots_.size()) {
         grow();
         mask = slots_.size() - 1;
-        s = hashOf(code) & mask;
+        s = hashOf(chunk) & mask;
         while (slots_[s] != 0) s = (s + 1) & mask;
       }
-      slots_[s] = code + 1;
+      slots_[s] = chunk + 1;
       slot_index_[s] = static_cast<std::uint32_t>(codes_.size());
-      codes_.push_back(code);
+      codes_.push_back(spreadBits(chunk & 0xFFFFU) | (spreadBits((chunk >> 16) & 0xFFFFU) << 1) |
+                       (spreadBits(chunk >> 32) << 2));
       words_.emplace_back();
       return codes_.size() - 1;
     }
   }
 
   void grow() {
-    slots_.assign(slots_.size() * 2, 0);
-    slot_index_.assign(slots_.size(), 0);
+    std::vector<std::uint64_t> old_slots(slots_.size() * 2, 0);
+    std::vector<std::uint32_t> old_index(slots_.size() * 2, 0);
+    old_slots.swap(slots_);
+    old_index.swap(slot_index_);
     const std::size_t mask = slots_.size() - 1;
-    for (std::size_t index = 0; index < codes_.size(); ++index) {
-      std::size_t s = hashOf(codes_[index]) & mask;
+    for (std::size_t old = 0; old < old_slots.size(); ++old) {
+      if (old_slots[old] == 0) continue;
+      std::size_t s = hashOf(old_slots[old] - 1) & mask;
       while (slots_[s] != 0) s = (s + 1) & mask;
-      slots_[s] = codes_[index] + 1;
-      slot_index_[s] = static_cast<std::uint32_t>(index);
+      slots_[s] = old_slots[old];
+      slot_index_[s] = old_index[old];
     }
   }
 
-  std::vector<std::uint64_t> slots_;       // chunk code + 1; 0 = empty
+  std::vector<std::uint64_t> slots_;       // packed chunk coordinates (chunkOf) + 1; 0 = empty
   std::vector<std::uint32_t> slot_index_;  // index into codes_ and words_
   std::vector<std::uint64_t> codes_;
   std::vector<ChunkWords> words_;

@@ -16,6 +16,7 @@ namespace mlmap {
 namespace {
 
 constexpr std::uint32_t kEmptySlot = std::numeric_limits<std::uint32_t>::max();
+constexpr std::size_t kInitialSlots = 1024;  // the cell grid's hash table, a power of two
 constexpr std::size_t kMaxBlocksPerCell = std::numeric_limits<std::uint16_t>::max();
 
 std::uint64_t packCell(CellIndex cell) {
@@ -83,7 +84,7 @@ MLMap::MLMap(double cell_size) : cell_size_(cell_size), inverse_cell_size_(1.0 /
   if (!(cell_size > 0.0) || !std::isfinite(cell_size)) {
     throw Error("cell size must be a positive number of metres, got " + std::to_string(cell_size));
   }
-  slots_.assign(1024, kEmptySlot);
+  slots_.assign(kInitialSlots, kEmptySlot);
 }
 
 std::optional<CellIndex> MLMap::findCellOf(double x, double y) const {
@@ -411,7 +412,28 @@ MLMapStats MLMap::stats() const {
   return stats;
 }
 
+std::size_t MLMap::packedMemoryBytes(std::size_t cells, std::size_t blocks) {
+  std::size_t slots = kInitialSlots;
+  while (cells * 2 > slots) slots *= 2;
+  return cells * sizeof(Cell) + blocks * sizeof(Block) + slots * sizeof(std::uint32_t) + sizeof(MLMap);
+}
+
+void MLMap::reserve(std::size_t cells, std::size_t blocks) {
+  cells_.reserve(cells);
+  blocks_.reserve(blocks);
+  std::size_t slots = slots_.size();  // the size findOrCreateCell's growth would reach
+  while (cells * 2 > slots) slots *= 2;
+  if (slots != slots_.size()) rehash(slots);
+}
+
 void MLMap::compact() {
+  if (blocks_.size() == block_count_) {
+    // No slack (every cell's room holds exactly its blocks, none left behind by a move):
+    // packed already, as a restored map is.
+    blocks_.shrink_to_fit();
+    cells_.shrink_to_fit();
+    return;
+  }
   std::vector<Block> packed;
   packed.reserve(block_count_);
   for (Cell& cell : cells_) {

@@ -90,17 +90,60 @@ unsigned childOf(std::uint64_t code, unsigned depth) {
   return static_cast<unsigned>(code >> (3 * (kDepth - 1 - depth))) & 7U;
 }
 
+constexpr std::uint64_t kChunkVoxels = std::uint64_t{1} << (3 * kChunkBits);
+
+enum class Uniform : unsigned char { kNo, kMiss, kHit };
+
+// Whether the scan updates every voxel of codes [first, first + count) (one node's, an
+// aligned power of 8) alike: all crossed and none hit, or all hit. `chunk` holds
+// `first`; the chunks after it, up to `end`, in ascending code.
+//
+// Such a node, when it has no children (pruned, or just created or expanded), ends
+// as OctoMap leaves it when it expands the node down to the voxels, updates each
+// alike and prunes them all again: one leaf holding its value plus the update,
+// clamped, or unchanged when saturated. Taking that step at once saves the nodes'
+// allocation and deletion: 7.8 M nodes created and 6.8 M deleted for a tree of 1 M
+// on the 5 cm lab, 8 scans.
+Uniform uniformUpdate(const ChunkUpdate* chunk, const ChunkUpdate* end, std::uint64_t first, std::uint64_t count) {
+  bool all_hit = true;
+  bool no_hit = true;
+  for (std::uint64_t code = first; code < first + count; ++chunk) {
+    if (chunk == end || chunk->code != code >> (3 * kChunkBits)) return Uniform::kNo;
+    const std::uint64_t bit = code & (kChunkVoxels - 1);
+    const std::uint64_t n = std::min(first + count - code, kChunkVoxels - bit);
+    // n < 64: one aligned group of 8 (count 8) in one word; else whole words
+    const std::uint64_t mask = n >= 64 ? ~std::uint64_t{0} : ((std::uint64_t{1} << n) - 1) << (bit % 64);
+    for (std::uint64_t w = bit / 64; w < (bit + n + 63) / 64; ++w) {
+      const std::uint64_t hits = chunk->hit != nullptr ? (*chunk->hit)[w] & mask : 0;
+      const std::uint64_t frees = chunk->free != nullptr ? (*chunk->free)[w] & mask : 0;
+      all_hit = all_hit && hits == mask;
+      no_hit = no_hit && hits == 0;
+      if ((hits | frees) != mask || (!all_hit && !no_hit)) return Uniform::kNo;
+    }
+    code += n;
+  }
+  return all_hit ? Uniform::kHit : Uniform::kMiss;
+}
+
 // Walks the keys below one node (the root, or a subtree's root at `top`) in ascending
 // Morton code, keeping the path of the previous key.
 class TreeWalk {
  public:
   TreeWalk(const octomap::OcTree& tree, OcTreeNode* top, unsigned top_depth, bool top_created)
-      : tree_(tree), edits_(tree), top_depth_(top_depth), valid_(top_depth) {
+      : tree_(tree),
+        edits_(tree),
+        miss_update_(tree.getProbMissLog()),
+        hit_update_(tree.getProbHitLog()),
+        top_depth_(top_depth),
+        valid_(top_depth) {
     path_[top_depth] = top;
     created_[top_depth] = top_created;
   }
 
-  void visit(std::uint64_t code, float update) {
+  // Visits the voxel `code` of `chunk` (the walk's chunks end at `end`); returns the
+  // code after the last voxel it took: code + 1, or the end of a node whose voxels all
+  // take the same update (see uniformUpdate).
+  std::uint64_t visit(std::uint64_t code, const ChunkUpdate* chunk, const ChunkUpdate* end) {
     if (started_) {
       const auto group = static_cast<unsigned>(63 - std::countl_zero(code ^ previous_)) / 3;
       close(kDepth - 1 - group);
@@ -109,14 +152,25 @@ class TreeWalk {
     previous_ = code;
     for (unsigned d = valid_; d < kDepth; ++d) {
       OcTreeNode* node = path_[d];
+      if (!tree_.nodeHasChildren(node)) {
+        const std::uint64_t span = std::uint64_t{1} << (3 * (kDepth - d));
+        if ((code & (span - 1)) == 0) {  // the node's first voxel: this walk has not entered it yet
+          const Uniform uniform = uniformUpdate(chunk, end, code, span);
+          if (uniform != Uniform::kNo) {
+            updateLeaf(node, uniform == Uniform::kHit ? hit_update_ : miss_update_);
+            valid_ = d;
+            return code + span;
+          }
+        }
+      }
       const unsigned child = childOf(code, d);
       created_[d + 1] = false;
       if (!tree_.nodeChildExists(node, child)) {
         if (!tree_.nodeHasChildren(node) && !created_[d]) {
           // A pruned node: updateNode's early abort leaves it whole when saturated.
-          if (saturated(*node, update)) {
+          if (saturated(*node, updateOf(code, *chunk))) {
             valid_ = d;
-            return;
+            return code + 1;
           }
           edits_.expand(node);
         } else {
@@ -127,7 +181,8 @@ class TreeWalk {
       path_[d + 1] = tree_.getNodeChild(node, child);
     }
     valid_ = kDepth;
-    if (!saturated(*path_[kDepth], update)) tree_.updateNodeLogOdds(path_[kDepth], update);
+    updateLeaf(path_[kDepth], updateOf(code, *chunk));
+    return code + 1;
   }
 
   // Brings the nodes still on the path up to date, the top one last.
@@ -140,6 +195,17 @@ class TreeWalk {
   std::ptrdiff_t nodesAdded() const { return edits_.nodesAdded(); }
 
  private:
+  float updateOf(std::uint64_t code, const ChunkUpdate& chunk) const {
+    const std::uint64_t bit = code & (kChunkVoxels - 1);
+    return chunk.hit != nullptr && (((*chunk.hit)[bit / 64] >> (bit % 64)) & 1U) != 0 ? hit_update_ : miss_update_;
+  }
+
+  // updateNode's step at the node it stops at (a voxel, or a pruned or new node that
+  // stands for voxels all taking this update).
+  void updateLeaf(OcTreeNode* node, float update) const {
+    if (!saturated(*node, update)) tree_.updateNodeLogOdds(node, update);
+  }
+
   bool saturated(const OcTreeNode& node, float update) const {
     return (update >= 0 && node.getLogOdds() >= tree_.getClampingThresMaxLog()) ||
            (update <= 0 && node.getLogOdds() <= tree_.getClampingThresMinLog());
@@ -154,6 +220,8 @@ class TreeWalk {
 
   const octomap::OcTree& tree_;
   NodeEdits edits_;
+  float miss_update_;
+  float hit_update_;
   unsigned top_depth_;
   std::array<OcTreeNode*, kDepth + 1> path_{};
   std::array<bool, kDepth + 1> created_{};
@@ -162,18 +230,22 @@ class TreeWalk {
   std::uint64_t previous_ = 0;
 };
 
-// The chunks' voxels into a walk, free ones with the miss update, hit ones with the hit update.
-void walkChunks(TreeWalk& walk, const ChunkUpdate* first, const ChunkUpdate* last, float miss_update,
-                float hit_update) {
-  static const ChunkWords kNone{};
+// The chunks' voxels into a walk, in ascending code, skipping those a visit took with its node.
+void walkChunks(TreeWalk& walk, const ChunkUpdate* first, const ChunkUpdate* last) {
+  std::uint64_t next = 0;  // the voxels below this code are done
   for (const ChunkUpdate* chunk = first; chunk != last; ++chunk) {
-    const ChunkWords& free_words = chunk->free != nullptr ? *chunk->free : kNone;
-    const ChunkWords& hit_words = chunk->hit != nullptr ? *chunk->hit : kNone;
+    const std::uint64_t base = chunk->code << (3 * kChunkBits);
+    if (next >= base + kChunkVoxels) continue;
     for (std::size_t w = 0; w < kChunkWords; ++w) {
-      const std::uint64_t hits = hit_words[w];
-      forEachCode(chunk->code, w, free_words[w] | hits, [&](std::uint64_t key_code) {
-        walk.visit(key_code, (hits >> (key_code & 63U)) & 1U ? hit_update : miss_update);
-      });
+      const std::uint64_t word_base = base + 64 * w;
+      if (next >= word_base + 64) continue;
+      std::uint64_t bits = (chunk->free != nullptr ? (*chunk->free)[w] : 0) | (chunk->hit != nullptr ? (*chunk->hit)[w] : 0);
+      if (next > word_base) bits &= ~std::uint64_t{0} << (next - word_base);
+      while (bits != 0) {
+        next = walk.visit(word_base + static_cast<std::uint64_t>(std::countr_zero(bits)), chunk, last);
+        if (next >= word_base + 64) break;
+        bits &= ~std::uint64_t{0} << (next - word_base);
+      }
     }
   }
 }
@@ -266,8 +338,6 @@ std::vector<Subtree> prepareSubtrees(const std::vector<ChunkUpdate>& chunks, uns
 
 void updateTree(octomap::OcTree& tree, const std::vector<ChunkUpdate>& chunks, unsigned split_depth) {
   if (chunks.empty()) return;
-  const float miss_update = tree.getProbMissLog();
-  const float hit_update = tree.getProbHitLog();
   OcTreeNode*& root = tree.*TreeMembers::kRoot;
   std::ptrdiff_t nodes_added = 0;
   bool root_created = false;
@@ -286,7 +356,7 @@ void updateTree(octomap::OcTree& tree, const std::vector<ChunkUpdate>& chunks, u
     for (std::int64_t s = 0; s < count; ++s) {
       const Subtree& subtree = subtrees[static_cast<std::size_t>(s)];
       TreeWalk walk(tree, subtree.top, split, subtree.created);
-      walkChunks(walk, chunks.data() + subtree.first, chunks.data() + subtree.last, miss_update, hit_update);
+      walkChunks(walk, chunks.data() + subtree.first, chunks.data() + subtree.last);
       walk.finish();
       nodes_added += walk.nodesAdded();
     }
@@ -306,7 +376,7 @@ void updateTree(octomap::OcTree& tree, const std::vector<ChunkUpdate>& chunks, u
     }
   } else {
     TreeWalk walk(tree, root, 0, root_created);
-    walkChunks(walk, chunks.data(), chunks.data() + chunks.size(), miss_update, hit_update);
+    walkChunks(walk, chunks.data(), chunks.data() + chunks.size());
     walk.finish();
     nodes_added += walk.nodesAdded();
   }

@@ -35,11 +35,14 @@ void writeMap(const std::filesystem::path& path, const Map& map);
 // of another version, or anything that is not an .mlmap file.
 Map readMap(const std::filesystem::path& path);
 
-// The map without its OcTree (hasOctree() false), and what the OcTree section holds,
-// counted without building it (nullopt when the file has none): for `mlmap info`.
+// For `mlmap info`: the map's parameters and planes, without its blocks and OcTree
+// (map.blocks() empty, hasOctree() false); what the OcTree section holds, counted
+// without building it (nullopt when the file has none); and the block layer's figures
+// as readMap(path).blocks().stats() gives them, counted without restoring the blocks.
 struct MapSummary {
   Map map;
   std::optional<OctreeSummary> octree;
+  MLMapStats blocks;
 };
 MapSummary readMapSummary(const std::filesystem::path& path);
 

@@ -61,6 +61,12 @@ class MLMap {
 
   // Releases the slack left by cells that grew; call after building.
   void compact();
+  // Room for this many cells and blocks in all, allocated at once (reading a map file,
+  // whose header gives both, instead of growing the arena and the grid step by step).
+  void reserve(std::size_t cells, std::size_t blocks);
+  // stats().memory_bytes of a compacted map of this many (non-empty) cells and blocks,
+  // as reading a map file leaves it.
+  static std::size_t packedMemoryBytes(std::size_t cells, std::size_t blocks);
 
  private:
   struct Cell {
