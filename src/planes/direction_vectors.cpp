@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "smallest_axis.hpp"
+#include "wall_line.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -104,20 +105,6 @@ struct Moments {
   }
 };
 
-// A block's direction and the standard error of its angle (radians, per axis; infinite
-// where the window holds no more blocks than the fit has unknowns): the residual's
-// variance s² = λ₀ n / (n − k) over the spread along the window's thinnest way in the
-// surface, s / √(n λ₁).
-struct Direction {
-  Eigen::Vector3f vector = Eigen::Vector3f::Zero();
-  double tilt = std::numeric_limits<double>::infinity();
-};
-
-double tiltOf(double residual_variance, double spread_variance, double n, double unknowns) {
-  if (!(n > unknowns) || !(spread_variance > 0.0)) return std::numeric_limits<double>::infinity();
-  return std::atan(std::sqrt(residual_variance * n / (n - unknowns) / (n * spread_variance)));
-}
-
 Direction horizontalDirection(const PlaneBlock& self, const Column* const* window, int radius, float height_tolerance,
                               double cell, double min_spread) {
   Moments sums;
@@ -145,62 +132,6 @@ Direction horizontalDirection(const PlaneBlock& self, const Column* const* windo
   if (smallest.middle_eigenvalue < min_spread) return {};
   return {orientConsistently(smallest.axis.cast<float>()),
           tiltOf(smallest.smallest_eigenvalue, smallest.middle_eigenvalue, n, 3.0)};
-}
-
-// The variance across the principal axis of a 2 × 2 covariance.
-double smallerEigenvalue(const Eigen::Matrix2d& covariance) {
-  const double difference = covariance(0, 0) - covariance(1, 1);
-  return 0.5 * (covariance.trace() - std::sqrt(difference * difference + 4.0 * covariance(0, 1) * covariance(0, 1)));
-}
-
-// A wall's line through its window: the principal axis of its blocks' positions.
-Direction lineDirection(const Eigen::Matrix2d& covariance, double n, double min_spread) {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver;
-  solver.computeDirect(covariance);
-  if (solver.eigenvalues()(1) < min_spread) return {};
-  const Eigen::Vector2d normal = solver.eigenvectors().col(0);
-  return {orientConsistently(Eigen::Vector3f(static_cast<float>(normal.x()), static_cast<float>(normal.y()), 0.0F)),
-          tiltOf(std::max(0.0, solver.eigenvalues()(0)), solver.eigenvalues()(1), n, 2.0)};
-}
-
-// Where a window holds a corner (the end of a cabinet, a wall piece between two door
-// jambs: every block within r cells of a turn), its blocks lie on two lines and their
-// principal axis on neither. Then the line through the block itself that most of them
-// lie on, within `reach` cells, fitted again to those: a 0.4 m face at 10 cm cells keeps
-// its own direction. `positions`: the window's blocks (cells, from its centre cell).
-Direction cornerDirection(const std::vector<Eigen::Vector2f>& positions, const Eigen::Vector2f& self, float reach,
-                          double max_residual, double cell, double min_spread) {
-  std::size_t best_inliers = 0;
-  Eigen::Vector2f best_normal = Eigen::Vector2f::Zero();
-  for (const Eigen::Vector2f& through : positions) {
-    const Eigen::Vector2f along = through - self;
-    if (along.squaredNorm() < 0.25F) continue;  // half a cell: too close to fix a direction
-    const Eigen::Vector2f normal = Eigen::Vector2f(-along.y(), along.x()).normalized();
-    std::size_t inliers = 0;
-    for (const Eigen::Vector2f& p : positions) inliers += std::abs(normal.dot(p - self)) <= reach ? 1 : 0;
-    if (inliers > best_inliers) {
-      best_inliers = inliers;
-      best_normal = normal;
-    }
-  }
-  if (best_inliers < 2) return {};
-  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-  Eigen::Matrix2d outer = Eigen::Matrix2d::Zero();
-  for (const Eigen::Vector2f& p : positions) {
-    if (std::abs(best_normal.dot(p - self)) > reach) continue;
-    const Eigen::Vector2d q = p.cast<double>() * cell;
-    sum += q;
-    outer += q * q.transpose();
-  }
-  const auto n = static_cast<double>(best_inliers);
-  const Eigen::Vector2d mean = sum / n;
-  const Eigen::Matrix2d covariance = outer / n - mean * mean.transpose();
-  // A straight face's blocks lie on their line by their points' noise (and, where a
-  // riser's cells also hold its treads' points, by a part of a cell); blocks round a
-  // pillar or a bin fill the band about a chord. Those keep the window's direction,
-  // whose fanning out tells the curve (the spread rule).
-  if (smallerEigenvalue(covariance) > max_residual * max_residual) return {};
-  return lineDirection(covariance, n, min_spread);
 }
 
 Direction verticalDirection(const PlaneBlock& self, const Column* const* window, int radius, double cell,
