@@ -10,32 +10,13 @@
 
 #include "key_bits.hpp"
 #include "octree_walk.hpp"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include "omp_threads.hpp"
 
 namespace mlmap::detail {
 namespace {
 
 using octomap::OcTreeKey;
 using octomap::point3d;
-
-int threadCount() {
-#ifdef _OPENMP
-  return omp_get_max_threads();
-#else
-  return 1;
-#endif
-}
-
-int threadIndex() {
-#ifdef _OPENMP
-  return omp_get_thread_num();
-#else
-  return 0;
-#endif
-}
 
 // One axis of a ray's steps through the Morton index of a voxel in its chunk: the
 // axis's bits of the index (every third) form the voxel's coordinate in the chunk, and

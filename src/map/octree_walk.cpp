@@ -16,9 +16,7 @@
 #include <bit>
 #include <cstddef>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include "omp_threads.hpp"
 
 namespace mlmap::detail {
 namespace {
@@ -264,14 +262,6 @@ unsigned splitDepth(const std::vector<ChunkUpdate>& chunks, int threads) {
     if (subtrees >= wanted) return depth;
   }
   return kChunkDepth;
-}
-
-int threadCount() {
-#ifdef _OPENMP
-  return omp_get_max_threads();
-#else
-  return 1;
-#endif
 }
 
 struct Subtree {
