@@ -54,8 +54,7 @@ double medianDistance(const BlockGrid& grid, const std::vector<std::uint32_t>& i
 // per vertical block (its top and its bottom). A patch needs ErmsmConfig::min_patch_blocks
 // of them: a wall's face three cells wide is as well determined as a floor's six cells,
 // and counting blocks lost the 0.5 m ends of lockers and cabinets (1.2-1.8 m tall, three
-// vertical blocks at 10 cm cells) of the simulated corridor, and wall pieces between
-// doorways on real scans (issue 19).
+// vertical blocks at 10 cm cells) of the simulated corridor (issue 19).
 std::size_t fitPoints(const BlockGrid& grid, const Patch& patch);
 
 // A patch one cell wide is no surface: it is the fringe of a wall standing on a cell

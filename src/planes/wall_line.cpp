@@ -1,6 +1,7 @@
 #include "wall_line.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 #include "mlmap/planes/direction_vectors.hpp"
