@@ -57,18 +57,17 @@ SlideProfile slideProfile(const std::vector<Point>& source, const std::vector<Ei
   // A target surface is found within the bound or, where the target samples it sparsely, the
   // voxel; the point-to-plane residual then decides.
   const double gate = std::max(bound, target.voxelSize());
+  // On one thread: at most kMaxProfilePoints lookups a shift, less than a fork-join costs.
   const auto explainedAt = [&](double shift) {
     const Eigen::Vector3d offset = shift * d;
-    std::int64_t count = 0;
-    const auto n = static_cast<std::int64_t>(facing.size());
-#pragma omp parallel for reduction(+ : count) schedule(static) if (n >= 2000)
-    for (std::int64_t k = 0; k < n; ++k) {
-      const Point moved = facing[static_cast<std::size_t>(k)] + offset;
+    std::size_t count = 0;
+    for (const Point& point : facing) {
+      const Point moved = point + offset;
       const std::optional<Neighbour> neighbour = target.nearest(moved, gate);
       if (!neighbour || std::abs(neighbour->normal.dot(d)) < kFacing) continue;
       if (std::abs(neighbour->normal.dot(moved - neighbour->point)) <= bound) ++count;
     }
-    return static_cast<std::size_t>(count);
+    return count;
   };
 
   profile.at_result = explainedAt(0.0);
