@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <optional>
 
 #include "candidates.hpp"
@@ -22,6 +23,7 @@
 #include "patch_rules.hpp"
 #include "patch_set.hpp"
 #include "plane_scorer.hpp"
+#include "sheets.hpp"
 #include "surface_noise.hpp"
 #include "unseen_gaps.hpp"
 
@@ -57,6 +59,14 @@ int teamSize(int threads) {
 #endif
 }
 
+// m: the most two neighbouring blocks of one sheet (sheets.hpp) may differ by in their
+// distance from their plane: 3 standard deviations of the difference of two points'
+// noise, 3 √2 σ, and at least half a cell: a block is the mean of what its cell holds,
+// and where that is a surface's edge or a second surface (a wall's foot, a corner) the
+// mean moves by up to half a cell (the simulated lab at 10 cm cells, 4 mm noise: its
+// walls were cut at 3 √2 σ alone).
+double sheetStep(double noise, double cell_size) { return std::max(3.0 * std::numbers::sqrt2 * noise, 0.5 * cell_size); }
+
 // The range noise of the map's points: a vertical block keeps the variance of its
 // top measurement (section IV), so their median is a measurement's. 1 cm without any.
 double rangeNoise(const MLMap& map) {
@@ -82,14 +92,16 @@ bool hasPointStats(const MLMap& map) {
 
 class Detector {
  public:
-  Detector(const BlockGrid& grid, const DirectionField& field, const ErmsmConfig& config)
+  // `sheets`: cut planes into sheets (the blocks keep their points' moments, σ is known).
+  Detector(const BlockGrid& grid, const DirectionField& field, const ErmsmConfig& config, bool sheets)
       : grid_(grid),
         directions_(field.vectors),
         tilts_(field.tilts),
         config_(config),
         scorer_(grid, field.vectors, config.epsilon, radians(config.kappa_deg), config.threads),
         min_score_(config.min_area / (grid.cellSize() * grid.cellSize())),
-        patch_threads_(teamSize(patchPassThreads(grid, config.threads))) {
+        patch_threads_(teamSize(patchPassThreads(grid, config.threads))),
+        sheet_step_(sheets ? sheetStep(config.noise, grid.cellSize()) : std::numeric_limits<double>::infinity()) {
     patches_.labels.assign(grid.size(), 0);
     FillVector<std::uint8_t> directed(grid.size());
     const auto blocks = static_cast<std::int64_t>(grid.size());
@@ -114,6 +126,7 @@ class Detector {
   bool noiseExplainsSpread(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const;
   bool nearlyLevel(const CandidatePlane& plane) const;
   bool liesOnPlane(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const;
+  SplitPatches splitSheets(const std::vector<std::uint32_t>& matching, const CandidatePlane& plane) const;
   bool accept(std::size_t index);
   void drop(std::size_t index);
 
@@ -124,6 +137,11 @@ class Detector {
   PlaneScorer scorer_;
   double min_score_;
   int patch_threads_;  // for the passes over an accepted plane's blocks
+  // m: neighbouring blocks of one sheet differ by at most this in their distance from
+  // their plane (splitSheets, sheetStep); infinite without sheets, as for blocks at cell
+  // centres (maps before format 3), where a wall on a cell boundary is two columns a cell
+  // apart.
+  double sheet_step_;
   std::vector<std::uint32_t> seedable_;  // blocks with a direction vector, in map order; taken ones pruned now and then
   std::size_t seedable_taken_ = 0;       // of which taken
   std::vector<Candidate> candidates_;    // L_c
@@ -234,6 +252,47 @@ void Detector::drop(std::size_t index) {
   candidates_.erase(candidates_.begin() + static_cast<long>(index));
 }
 
+// The patches of an accepted plane's blocks: its sheets (sheets.hpp), each cut into
+// connected pieces (gap 2 cells) and a wall's pieces joined across unseen gaps; largest
+// first. Neighbouring blocks of one sheet differ in their distance from the plane by at
+// most 3 standard deviations of the difference of two of the noise's: 3 √2 σ. Where
+// that exceeds the slab (2 ε) every block is in one sheet and the pass is skipped.
+SplitPatches Detector::splitSheets(const std::vector<std::uint32_t>& matching, const CandidatePlane& plane) const {
+  const double step = sheet_step_;
+  const Eigen::Vector3d normal = plane.normal.cast<double>();
+  const Eigen::Vector3d point = plane.point.cast<double>();
+  SplitPatches split;
+  if (step >= 2.0 * config_.epsilon) {
+    split = splitWithOutlineRuns(grid_, matching, normal, point, 2, patch_threads_);
+  } else {
+    for (const std::vector<std::uint32_t>& sheet : sheetsOf(grid_, matching, plane, step, 2)) {
+      SplitPatches pieces = splitWithOutlineRuns(grid_, sheet, normal, point, 2, patch_threads_);
+      for (std::size_t k = 0; k < pieces.patches.size(); ++k) {
+        split.patches.push_back(std::move(pieces.patches[k]));
+        split.outline_runs.push_back(std::move(pieces.outline_runs[k]));
+      }
+    }
+    std::vector<std::size_t> order(split.patches.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return split.patches[a].surface > split.patches[b].surface; });
+    SplitPatches sorted;
+    for (const std::size_t k : order) {
+      sorted.patches.push_back(std::move(split.patches[k]));
+      sorted.outline_runs.push_back(std::move(split.outline_runs[k]));
+    }
+    split = std::move(sorted);
+  }
+  // A wall's pieces are joined across unseen gaps along it, whichever sheets they are
+  // of; pieces one above the other (a sheet's step) are not along the wall.
+  const std::size_t count = split.patches.size();
+  joinUnseenGaps(grid_, split.patches, normal, point, config_.epsilon, std::max<std::size_t>(config_.min_patch_blocks, 1),
+                 config_.min_patch_area / (grid_.cellSize() * grid_.cellSize()), 0.3, step);
+  // A join leaves fewer patches: theirs are rasterised again for their outlines.
+  if (split.patches.size() != count) split.outline_runs.assign(split.patches.size(), {});
+  return split;
+}
+
 // Lines 8–11 of Algorithm 1: the matching blocks leave the map (split into
 // connected patches), and candidates seeded on them leave the list.
 bool Detector::accept(std::size_t index) {
@@ -259,15 +318,8 @@ bool Detector::accept(std::size_t index) {
   }
   const std::vector<std::uint32_t> matching =
       withEdges(grid_, directions_, scorer_, strict, accepted.plane, config_.epsilon, kappa);
-  SplitPatches split = splitWithOutlineRuns(grid_, matching, accepted.plane.normal.cast<double>(),
-                                            accepted.plane.point.cast<double>(), 2, patch_threads_);
-  const std::size_t pieces = split.patches.size();
   const double cell_area = grid_.cellSize() * grid_.cellSize();
-  joinUnseenGaps(grid_, split.patches, accepted.plane.normal.cast<double>(), accepted.plane.point.cast<double>(),
-                 config_.epsilon, std::max<std::size_t>(config_.min_patch_blocks, 1), config_.min_patch_area / cell_area);
-  // A join (a wall's pieces) leaves fewer patches: theirs are rasterised again for
-  // their outlines.
-  if (split.patches.size() != pieces) split.outline_runs.assign(split.patches.size(), {});
+  SplitPatches split = splitSheets(matching, accepted.plane);
   const double min_width =
       (level ? config_.min_level_patch_width_cells : config_.min_patch_width_cells) * grid_.cellSize();
   std::vector<std::uint32_t> taken;
@@ -391,9 +443,11 @@ PatchSet Detector::run(ErmsmStats& stats) {
   stats.stages.patches += secondsSince(describe_start);
   stats.stages.search = std::max(0.0, secondsSince(start) - stats.stages.patches);
   const auto merge_start = Clock::now();
-  // Block points sit at cell centres: pieces of one surface lie up to half a cell
-  // further apart than ε allows a block.
-  mergeCoplanar(grid_, patches_, config_.epsilon + 0.5 * grid_.cellSize(), radians(config_.kappa_deg));
+  // Block points sit at cell centres (before format 3): pieces of one surface lie up to
+  // half a cell further apart than ε allows a block. Where they sit at their points, a
+  // piece further off than a sheet's step is another layer (sheets.hpp).
+  mergeCoplanar(grid_, patches_, std::min(config_.epsilon + 0.5 * grid_.cellSize(), sheet_step_),
+                radians(config_.kappa_deg));
   stats.stages.merges = secondsSince(merge_start);
   // Classification reads the outlines: the patches' and the merged groups' traced now.
   const auto outline_start = Clock::now();
@@ -416,8 +470,8 @@ double defaultEpsilon(bool at_points, double cell_size, double noise) {
 
 // One detection with σ and ε resolved (config.noise, config.epsilon > 0).
 // `block_noise`: the σ the blocks' variances were fused with (rangeNoise), which the rung
-// test compares them in.
-PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config, double block_noise) {
+// test compares them in. `sheets`: σ is known, planes are cut into sheets with it.
+PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config, double block_noise, bool sheets) {
   const auto start = Clock::now();
   auto stage_start = start;
   PlaneDetection detection;
@@ -458,7 +512,7 @@ PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config, double bl
       std::count_if(directions.vectors.begin(), directions.vectors.end(), [](const Eigen::Vector3f& d) { return d.squaredNorm() > 0.0F; }));
 
   const auto detection_start = Clock::now();
-  Detector detector(grid, directions, config);
+  Detector detector(grid, directions, config, sheets && hasPointStats(map));
   stats.stages.index = stage();
   PatchSet patches = detector.run(stats);
   stage();
@@ -491,19 +545,19 @@ PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config, double bl
 
 }  // namespace
 
-// σ sets ε (3 σ), the level band (5 σ) and the rung variance. Without --noise it is the
-// blocks' own variance first: what the build was told about its measurements (3 cm for
-// points from a file, whatever the scanner), not what they are. Where the blocks keep
-// their points, the planes of that first pass then measure it: the median RMS distance
-// of a block's points from its patch (surface_noise.hpp), about the noise the planes
-// must tolerate, surface waviness and registration included. On the real scans of
-// bench/real_data.py at 5 cm cells, against 3 cm assumed: 3DTK 2.3 cm, OctoMap's fr079
-// 0.9, Bobkov's room 1.9, PCL's office1 1.2 and room scans 1.2-1.3, plane_seg's stairs
-// 1.0 and 0.8. The planes are detected again with it unless it lies within 25 % of the
-// first σ: on those eight scans the estimate itself moves by 16-53 % (median 28 %)
-// between 5 and 10 cm cells, and its median over 100 blocks spreads -11..-29 % to
-// +15..+41 % (95 % of 400 bootstrap draws; surface_noise.hpp), so a smaller difference
-// is not a measured one.
+// σ sets ε (3 σ), the level band (5 σ), the step between sheets (3 √2 σ) and the rung
+// variance. Without --noise it is the blocks' own variance first: what the build was
+// told about its measurements (3 cm for points from a file, whatever the scanner), not
+// what they are. Where the blocks keep their points, the planes of that first pass then
+// measure it: the median RMS distance of a block's points from its patch
+// (surface_noise.hpp), about the noise the planes must tolerate, surface waviness and
+// registration included. On the real scans of bench/real_data.py at 5 cm cells, against
+// 3 cm assumed: 3DTK 2.3 cm, OctoMap's fr079 0.9, Bobkov's room 1.9, PCL's office1 1.2
+// and room scans 1.2-1.3, plane_seg's stairs 1.0 and 0.8. The planes are detected again
+// with it, σ moved only where it lies beyond 25 % of the first: on those eight scans the
+// estimate itself moves by 16-53 % (median 28 %) between 5 and 10 cm cells, and its
+// median over 100 blocks spreads -11..-29 % to +15..+41 % (95 % of 400 bootstrap draws;
+// surface_noise.hpp), so a smaller difference is not a measured one.
 PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   const auto start = Clock::now();
   const bool at_points = hasPointStats(map);
@@ -518,33 +572,33 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
     detection.stats.direction_seconds += seconds;
   };
   const double estimate_seconds = secondsSince(start);
-  PlaneDetection detection = detectOnce(map, config, block_noise);
-  const std::optional<double> measured = measure ? surfaceNoise(map, detection.planes) : std::nullopt;
-  if (!measured || *measured <= 0.0 || std::abs(std::log(*measured / config.noise)) <= std::log(1.25)) {
+  // Sheets (sheets.hpp) only with σ known: given, or measured by the first pass. From
+  // the σ assumed for points from a file (3 mm for a depth camera's PCD) the first pass
+  // cut PCL's office1's walls and floor into their depth layers.
+  PlaneDetection detection = detectOnce(map, config, block_noise, !measure);
+  std::optional<double> measured = measure ? surfaceNoise(map, detection.planes) : std::nullopt;
+  if (!measured) {
     chargeNoise(detection, estimate_seconds);
     return detection;
   }
+  // A depth camera's quantised depths put a surface's points on a few exact layers:
+  // blocks of one layer have no scatter at all. No range sensor of the data sets
+  // measures closer than a few mm (the simulated scans 4 mm).
+  measured = std::max(*measured, 0.001);
   ErmsmConfig again = input_config;
-  again.noise = *measured;
+  // The measurement moves σ (ε, the level band) only by more than its own uncertainty:
+  // within 25 % of the first σ the first is kept. Either way the second pass cuts the
+  // planes into sheets with it.
+  again.noise = std::abs(std::log(*measured / config.noise)) <= std::log(1.25) ? config.noise : *measured;
   // ε is widened by the measurement, never narrowed: a median over all blocks speaks for
   // the surfaces seen best, and a sparse, far one (3DTK's ceiling at 5 cm cells; the 4 cm
   // ceiling over a 1 cm floor of tests/test_planes_noisy.cpp) is lost with ε from the
   // floor's noise. Narrowing it found plane_seg's first stair tread at 5 cm cells and
   // lost room walls of PCL's room_scan1 and room_scan2.
-  if (again.epsilon <= 0.0) again.epsilon = defaultEpsilon(at_points, map.cellSize(), std::max(config.noise, *measured));
-  // σ sets only ε and the level band (never narrower than a cell): where neither moves
-  // (a simulated scan's 0.4 cm against 1 cm assumed, both bands a cell), a second pass
-  // would find the very same planes.
-  const auto levelBand = [&map](double noise) { return std::max(5.0 * noise, map.cellSize()); };
-  if (again.epsilon == config.epsilon && levelBand(again.noise) == levelBand(config.noise)) {
-    detection.config.noise = again.noise;
-    detection.stats.prior_noise = config.noise;
-    chargeNoise(detection, estimate_seconds);
-    return detection;
-  }
+  if (again.epsilon <= 0.0) again.epsilon = defaultEpsilon(at_points, map.cellSize(), std::max(config.noise, again.noise));
   const double first_pass_seconds = secondsSince(start);
-  detection = detectOnce(map, again, block_noise);
-  detection.stats.prior_noise = config.noise;
+  detection = detectOnce(map, again, block_noise, true);
+  if (again.noise != config.noise) detection.stats.prior_noise = config.noise;
   chargeNoise(detection, first_pass_seconds);
   return detection;
 }

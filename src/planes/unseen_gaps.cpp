@@ -11,16 +11,20 @@ struct Piece {
   std::size_t patch = 0;
   double low = 0.0;   // m, extent along the wall
   double high = 0.0;
+  double level = 0.0;  // m, its blocks' mean distance from the plane
 };
 
-Piece pieceOf(const BlockGrid& grid, const std::vector<Patch>& patches, std::size_t index,
+Piece pieceOf(const BlockGrid& grid, const std::vector<Patch>& patches, std::size_t index, const Eigen::Vector3d& normal,
               const Eigen::Vector3d& u_axis, const Eigen::Vector3d& point) {
-  Piece piece{index, 1e300, -1e300};
+  Piece piece{index, 1e300, -1e300, 0.0};
   for (const std::uint32_t id : patches[index].blocks) {
-    const double u = u_axis.dot(grid.blocks()[id].point.cast<double>() - point);
+    const Eigen::Vector3d offset = grid.blocks()[id].point.cast<double>() - point;
+    const double u = u_axis.dot(offset);
     piece.low = std::min(piece.low, u);
     piece.high = std::max(piece.high, u);
+    piece.level += normal.dot(offset);
   }
+  piece.level /= static_cast<double>(patches[index].blocks.size());
   return piece;
 }
 
@@ -54,7 +58,7 @@ bool seenThrough(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eig
 
 void joinUnseenGaps(const BlockGrid& grid, std::vector<Patch>& patches, const Eigen::Vector3d& normal,
                     const Eigen::Vector3d& point, double epsilon, std::size_t min_blocks, double min_surface,
-                    double reach) {
+                    double reach, double max_step) {
   if (patches.size() < 2 || std::abs(normal.z()) >= 0.2) return;
   Eigen::Vector3d u_axis;
   Eigen::Vector3d v_axis;
@@ -62,36 +66,46 @@ void joinUnseenGaps(const BlockGrid& grid, std::vector<Patch>& patches, const Ei
   std::vector<Piece> pieces;
   for (std::size_t k = 0; k < patches.size(); ++k) {
     if (patches[k].blocks.size() >= min_blocks && patches[k].surface >= min_surface) {
-      pieces.push_back(pieceOf(grid, patches, k, u_axis, point));
+      pieces.push_back(pieceOf(grid, patches, k, normal, u_axis, point));
     }
   }
   if (pieces.size() < 2) return;
-  std::stable_sort(pieces.begin(), pieces.end(), [](const Piece& a, const Piece& b) { return a.low < b.low; });
-  // Along the wall, each piece joins the run before it when a gap of more than a cell
-  // separates them and nothing was seen through it. Pieces beside each other along
-  // the wall (one above the other) stay apart: their gap is not along the wall.
+  // Layers first: pieces sorted by level, a new layer where consecutive levels differ by
+  // more than max_step; the pieces of each layer are joined on their own.
+  std::stable_sort(pieces.begin(), pieces.end(), [](const Piece& a, const Piece& b) { return a.level < b.level; });
   bool joined_any = false;
-  std::size_t run = pieces.front().patch;
-  double run_high = pieces.front().high;
-  for (std::size_t n = 1; n < pieces.size(); ++n) {
-    const Piece& piece = pieces[n];
-    if (piece.low > run_high + grid.cellSize() &&
-        !seenThrough(grid, normal, u_axis, point, run_high, piece.low, epsilon, reach)) {
-      Patch& into = patches[run];
-      Patch& from = patches[piece.patch];
-      std::vector<std::uint32_t> blocks;
-      blocks.reserve(into.blocks.size() + from.blocks.size());
-      std::merge(into.blocks.begin(), into.blocks.end(), from.blocks.begin(), from.blocks.end(),
-                 std::back_inserter(blocks));
-      into.blocks = std::move(blocks);
-      into.surface += from.surface;
-      from = Patch{};
-      run_high = std::max(run_high, piece.high);
-      joined_any = true;
-      continue;
+  std::size_t layer_begin = 0;
+  for (std::size_t end = 1; end <= pieces.size(); ++end) {
+    if (end < pieces.size() && pieces[end].level - pieces[end - 1].level <= max_step) continue;
+    std::vector<Piece> layer(pieces.begin() + static_cast<long>(layer_begin), pieces.begin() + static_cast<long>(end));
+    layer_begin = end;
+    if (layer.size() < 2) continue;
+    std::stable_sort(layer.begin(), layer.end(), [](const Piece& a, const Piece& b) { return a.low < b.low; });
+    // Along the wall, each piece joins the run before it when a gap of more than a cell
+    // separates them and nothing was seen through it. Pieces beside each other along
+    // the wall (one above the other) stay apart: their gap is not along the wall.
+    std::size_t run = layer.front().patch;
+    double run_high = layer.front().high;
+    for (std::size_t n = 1; n < layer.size(); ++n) {
+      const Piece& piece = layer[n];
+      if (piece.low > run_high + grid.cellSize() &&
+          !seenThrough(grid, normal, u_axis, point, run_high, piece.low, epsilon, reach)) {
+        Patch& into = patches[run];
+        Patch& from = patches[piece.patch];
+        std::vector<std::uint32_t> blocks;
+        blocks.reserve(into.blocks.size() + from.blocks.size());
+        std::merge(into.blocks.begin(), into.blocks.end(), from.blocks.begin(), from.blocks.end(),
+                   std::back_inserter(blocks));
+        into.blocks = std::move(blocks);
+        into.surface += from.surface;
+        from = Patch{};
+        run_high = std::max(run_high, piece.high);
+        joined_any = true;
+        continue;
+      }
+      run = piece.patch;
+      run_high = piece.high;
     }
-    run = piece.patch;
-    run_high = piece.high;
   }
   if (!joined_any) return;
   std::erase_if(patches, [](const Patch& patch) { return patch.blocks.empty(); });

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "mlmap/planes/block_grid.hpp"
@@ -21,9 +22,11 @@ namespace mlmap {
 // on their own, take part: fragments stay as they are. Planes that are not walls
 // (|n_z| ≥ 0.2) are left alone: between tables at one height the floor shows below and
 // the ceiling may be far above. Patches stay sorted largest first; a joined patch's
-// blocks stay ascending (its outline, traced later, is its largest piece's).
+// blocks stay ascending (its outline, traced later, is its largest piece's). Pieces whose
+// mean distances from the plane differ by more than `max_step` are layers (sheets.hpp),
+// not one wall: they stay apart.
 void joinUnseenGaps(const BlockGrid& grid, std::vector<Patch>& patches, const Eigen::Vector3d& normal,
                     const Eigen::Vector3d& point, double epsilon, std::size_t min_blocks, double min_surface,
-                    double reach = 0.3);
+                    double reach = 0.3, double max_step = std::numeric_limits<double>::infinity());
 
 }  // namespace mlmap
