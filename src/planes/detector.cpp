@@ -1,0 +1,351 @@
+#include "detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "fill_vector.hpp"
+#include "mlmap/planes/classify.hpp"
+#include "mlmap/planes/patches.hpp"
+#include "patch_rules.hpp"
+#include "sheets.hpp"
+#include "unseen_gaps.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace mlmap {
+namespace {
+
+// A patch of fewer blocks has its labels written on one thread.
+constexpr std::int64_t kParallelPatchBlocks = 20000;
+
+}  // namespace
+
+int teamSize(int threads) {
+#ifdef _OPENMP
+  return threads > 0 ? threads : omp_get_max_threads();
+#else
+  (void)threads;
+  return 1;
+#endif
+}
+
+double sheetStep(double noise, double cell_size) { return std::max(3.0 * std::numbers::sqrt2 * noise, 0.5 * cell_size); }
+
+Detector::Detector(const BlockGrid& grid, const DirectionField& field, const ErmsmConfig& config, bool sheets)
+    : grid_(grid),
+      directions_(field.vectors),
+      tilts_(field.tilts),
+      config_(config),
+      scorer_(grid, field.vectors, config.epsilon, radians(config.kappa_deg), config.threads),
+      min_score_(config.min_area / (grid.cellSize() * grid.cellSize())),
+      patch_threads_(teamSize(patchPassThreads(grid, config.threads))),
+      sheet_step_(sheets ? sheetStep(config.noise, grid.cellSize()) : std::numeric_limits<double>::infinity()) {
+  patches_.labels.assign(grid.size(), 0);
+  FillVector<std::uint8_t> directed(grid.size());
+  const auto blocks = static_cast<std::int64_t>(grid.size());
+#pragma omp parallel for schedule(static) num_threads(patch_threads_) if (patch_threads_ > 1)
+  for (std::int64_t id = 0; id < blocks; ++id) {
+    directed[static_cast<std::size_t>(id)] = field.vectors[static_cast<std::size_t>(id)].squaredNorm() > 0.0F ? 1 : 0;
+  }
+  seedable_ = grid.idsInMapOrder(directed, patch_threads_);
+}
+
+// Each patch into its own slot: the same planes at any thread count.
+void Detector::describePatches() {
+#ifdef _OPENMP
+  const int requested = patchPassThreads(grid_, config_.threads);
+  const int threads = requested > 0 ? requested : omp_get_max_threads();
+#endif
+  const double kappa = radians(config_.kappa_deg);
+  const auto count = static_cast<std::int64_t>(patches_.planes.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (count > 1)
+  for (std::int64_t n = 0; n < count; ++n) {
+    const auto k = static_cast<std::size_t>(n);
+    Patch patch;
+    patch.blocks = std::move(patches_.blocks[k]);
+    patch.surface = undescribed_[k].surface;
+    Plane described = describePatch(grid_, patch, undescribed_[k].reference, kappa);
+    Plane& plane = patches_.planes[k];
+    described.id = plane.id;
+    described.source = plane.source;
+    described.candidates = plane.candidates;
+    plane = std::move(described);
+    patches_.blocks[k] = std::move(patch.blocks);
+  }
+}
+
+// bestCandidate of Algorithm 1, lazily: a stale score is an upper bound (taking
+// blocks only lowers scores), so only the leader is ever rescored.
+std::optional<std::size_t> Detector::bestCandidate() {
+  while (!candidates_.empty()) {
+    std::size_t best = 0;
+    for (std::size_t k = 1; k < candidates_.size(); ++k) {
+      if (candidates_[k].score.score > candidates_[best].score.score) best = k;
+    }
+    Candidate& leader = candidates_[best];
+    if (!leader.stale) return best;
+    leader.score = scorer_.score(leader.plane);
+    leader.stale = false;
+    ++stats_->scored;
+    if (leader.score.score < min_score_) drop(best);
+  }
+  return std::nullopt;
+}
+
+// Eq. 6 with eq. 10's single-pass probability: P = 1 − (1 − (s_c / s_o)^k)^s, s the
+// candidates drawn since the list was last emptied of this plane's rivals.
+double Detector::acceptanceProbability(const Candidate& leader) const {
+  std::size_t listed = unlisted_;
+  for (const Candidate& candidate : candidates_) listed += static_cast<std::size_t>(candidate.multiplicity);
+  const double ratio = std::min(1.0, leader.score.score / std::max(leader.score.similar, 1e-9));
+  return 1.0 - std::pow(1.0 - std::pow(ratio, config_.acceptance_exponent), static_cast<double>(listed));
+}
+
+// A level plane whose blocks' directions spread more than max_direction_spread_deg may
+// still be a surface: its blocks scatter in height by the range noise, and where that is
+// a good part of a cell (3DTK's ceiling at 5 cm cells: 5.5 cm RMS) their directions
+// spread by more than 8° without any curvature. Accepted when the spread is within the
+// limit on top of that noise (the two adding in squares). Not for walls: a vertical
+// block's direction is uncertain where its window holds a corner or a pillar's turn,
+// which is what the spread rule is for (excusing that let 45° facets across the lab's
+// corners through).
+bool Detector::noiseExplainsSpread(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const {
+  const double limit = spreadLimit(config_.max_direction_spread_deg, noiseSpread(tilts_, strict, radians(config_.kappa_deg)));
+  return !spreadExceeds(grid_, directions_, strict, plane, limit, patch_threads_);
+}
+
+// A level plane within max_direction_spread_deg of level needs no direction test, only
+// liesOnPlane's: the level surfaces of buildings are (floors, ceilings, desks), and on real
+// scans their blocks' directions spread by more than the noise estimate says, because
+// what lies on them (papers, keyboards, lamps) tilts the windows. PCL's room_scan1 at
+// 5 cm cells: its two desks (4° and 6° off level by their own fits) spread 12-20°, and
+// Bobkov's sideboard (3.5°); none was a patch. A plane tilted further (a ramp, a chair's
+// back, plane_seg's cinder blocks at 13°) still meets the spread rule. The simulated
+// scenes' patches are the same either way (bench/planes_sweep.py, lab and corridor).
+bool Detector::nearlyLevel(const CandidatePlane& plane) const {
+  return std::abs(plane.normal.z()) >= std::cos(radians(config_.max_direction_spread_deg));
+}
+
+// A level plane's blocks must lie on it: their median distance (PlaneBlock::point)
+// from it at most ε / 3. Noise of σ ≤ ε / 3 puts it at 0.67 σ or less; a heap of clutter
+// filling the slab ±ε round the plane at ε / 2. Direction windows widened over a heap see
+// it level on average, so the spread rule alone no longer refuses one. A median, so that
+// blocks a chair or a lamp pulls off a table or ceiling do not count. Level planes only:
+// a vertical block sits at mid-height, its distance from a tilted plane says nothing.
+bool Detector::liesOnPlane(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const {
+  return medianDistance(grid_, strict, plane) <= config_.epsilon / 3.0;
+}
+
+void Detector::drop(std::size_t index) {
+  unlisted_ += static_cast<std::size_t>(candidates_[index].multiplicity);
+  candidates_.erase(candidates_.begin() + static_cast<long>(index));
+}
+
+// The patches of an accepted plane's blocks: its sheets (sheets.hpp), each cut into
+// connected pieces (gap 2 cells) and a wall's pieces joined across unseen gaps; largest
+// first. Neighbouring blocks of one sheet differ in their distance from the plane by at
+// most 3 standard deviations of the difference of two of the noise's: 3 √2 σ. Where
+// that exceeds the slab (2 ε) every block is in one sheet and the pass is skipped.
+SplitPatches Detector::splitSheets(const std::vector<std::uint32_t>& matching, const CandidatePlane& plane) const {
+  const double step = sheet_step_;
+  const Eigen::Vector3d normal = plane.normal.cast<double>();
+  const Eigen::Vector3d point = plane.point.cast<double>();
+  SplitPatches split;
+  if (step >= 2.0 * config_.epsilon) {
+    split = splitWithOutlineRuns(grid_, matching, normal, point, 2, patch_threads_);
+  } else {
+    for (const std::vector<std::uint32_t>& sheet : sheetsOf(grid_, matching, plane, step, 2)) {
+      SplitPatches pieces = splitWithOutlineRuns(grid_, sheet, normal, point, 2, patch_threads_);
+      for (std::size_t k = 0; k < pieces.patches.size(); ++k) {
+        split.patches.push_back(std::move(pieces.patches[k]));
+        split.outline_runs.push_back(std::move(pieces.outline_runs[k]));
+      }
+    }
+    std::vector<std::size_t> order(split.patches.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return split.patches[a].surface > split.patches[b].surface; });
+    SplitPatches sorted;
+    for (const std::size_t k : order) {
+      sorted.patches.push_back(std::move(split.patches[k]));
+      sorted.outline_runs.push_back(std::move(split.outline_runs[k]));
+    }
+    split = std::move(sorted);
+  }
+  // A wall's pieces are joined across unseen gaps along it, whichever sheets they are
+  // of; pieces one above the other (a sheet's step) are not along the wall.
+  const std::size_t count = split.patches.size();
+  joinUnseenGaps(grid_, split.patches, normal, point, config_.epsilon, std::max<std::size_t>(config_.min_patch_blocks, 1),
+                 config_.min_patch_area / (grid_.cellSize() * grid_.cellSize()), 0.3, step);
+  // A join leaves fewer patches: theirs are rasterised again for their outlines.
+  if (split.patches.size() != count) split.outline_runs.assign(split.patches.size(), {});
+  return split;
+}
+
+// Lines 8–11 of Algorithm 1: the matching blocks leave the map (split into
+// connected patches), and candidates seeded on them leave the list.
+bool Detector::accept(std::size_t index) {
+  const Candidate accepted = candidates_[index];
+  // Candidates seeded apart often refit to the very same plane: one that kept nothing
+  // keeps nothing again until blocks are taken.
+  const auto same = [&](const CandidatePlane& plane) {
+    return plane.normal == accepted.plane.normal && plane.point == accepted.plane.point;
+  };
+  if (std::any_of(refused_.begin(), refused_.end(), same)) {
+    drop(index);
+    return false;
+  }
+  const double kappa = radians(config_.kappa_deg);
+  const std::vector<std::uint32_t> strict = scorer_.matching(accepted.plane);
+  const bool level = std::abs(accepted.plane.normal.z()) >= std::cos(radians(45.0));
+  if ((level && !liesOnPlane(accepted.plane, strict)) ||
+      (spreadExceeds(grid_, directions_, strict, accepted.plane, config_.max_direction_spread_deg, patch_threads_) &&
+       !(level && (nearlyLevel(accepted.plane) || noiseExplainsSpread(accepted.plane, strict))))) {
+    refused_.push_back(accepted.plane);
+    drop(index);
+    return false;
+  }
+  const std::vector<std::uint32_t> matching =
+      withEdges(grid_, directions_, scorer_, strict, accepted.plane, config_.epsilon, kappa);
+  const double cell_area = grid_.cellSize() * grid_.cellSize();
+  SplitPatches split = splitSheets(matching, accepted.plane);
+  const double min_width =
+      (level ? config_.min_level_patch_width_cells : config_.min_patch_width_cells) * grid_.cellSize();
+  std::vector<std::uint32_t> taken;
+  for (std::size_t k = 0; k < split.patches.size(); ++k) {
+    Patch& patch = split.patches[k];
+    if (patch.surface * cell_area < config_.min_patch_area ||
+        fitPoints(grid_, patch) < static_cast<std::size_t>(config_.min_patch_blocks) ||
+        isThin(grid_, patch, accepted.plane, min_width, patch_threads_)) {
+      continue;
+    }
+    if (taken.empty()) ++accepted_;
+    // Described after the search (describePatches), its outline traced after the merges
+    // (tracePendingOutlines) on the plane it was split on.
+    Plane plane;
+    undescribed_.push_back(Undescribed{accepted.plane, patch.surface});
+    plane.id = static_cast<std::int32_t>(patches_.planes.size() + 1);
+    plane.source = accepted_;
+    plane.candidates = since_acceptance_;
+    const auto patch_size = static_cast<std::int64_t>(patch.blocks.size());
+#pragma omp parallel for schedule(static) num_threads(patch_threads_) if (patch_threads_ > 1 && patch_size > kParallelPatchBlocks)
+    for (std::int64_t n = 0; n < patch_size; ++n) patches_.labels[patch.blocks[static_cast<std::size_t>(n)]] = plane.id;
+    taken.insert(taken.end(), patch.blocks.begin(), patch.blocks.end());
+    patches_.outline_runs.push_back(std::move(split.outline_runs[k]));
+    patches_.blocks.push_back(std::move(patch.blocks));
+    patches_.outline_frames.push_back(
+        OutlineFrame{accepted.plane.normal.cast<double>(), accepted.plane.point.cast<double>(), true});
+    patches_.planes.push_back(std::move(plane));
+  }
+  if (taken.empty()) {
+    refused_.push_back(accepted.plane);
+    drop(index);
+    return false;
+  }
+  scorer_.take(taken);
+  refused_.clear();
+  std::vector<Candidate> remaining;
+  for (Candidate& candidate : candidates_) {
+    if (scorer_.taken(candidate.seeds[0]) || scorer_.taken(candidate.seeds[1]) || scorer_.taken(candidate.seeds[2])) {
+      continue;
+    }
+    candidate.stale = true;
+    remaining.push_back(std::move(candidate));
+  }
+  candidates_ = std::move(remaining);
+  // Draws skip taken seeds; prune them once they are a quarter of the list.
+  seedable_taken_ += taken.size();
+  if (4 * seedable_taken_ > seedable_.size()) {
+    std::erase_if(seedable_, [&](std::uint32_t id) { return scorer_.taken(id); });
+    seedable_taken_ = 0;
+  }
+  since_acceptance_ = 0;
+  return true;
+}
+
+PatchSet Detector::run(ErmsmStats& stats) {
+  const auto start = Clock::now();
+  stats_ = &stats;
+  const int batch = std::max(1, config_.batch_size);
+#ifdef _OPENMP
+  const int threads = config_.threads > 0 ? config_.threads : omp_get_max_threads();
+#endif
+  // Batches are drawn on several threads while that beats one: a batch takes well under
+  // a millisecond, and on a shared machine a parallel region can wait milliseconds for a
+  // core (the 10 cm corridor's search took 0.5 s at 2 threads instead of 0.011 s, and
+  // 0.02 s on one). Once a batch takes longer than its draws took added up, the rest are
+  // drawn on one thread. The candidates are the same either way.
+  bool parallel_draws = true;
+  std::vector<double> draw_seconds(static_cast<std::size_t>(batch));
+  std::uint64_t generated = 0;
+  int empty_batches = 0;
+  while (generated < static_cast<std::uint64_t>(config_.max_candidates) && seedable_.size() - seedable_taken_ >= 3) {
+    std::vector<CandidateDraw> draws(static_cast<std::size_t>(batch));
+    const CandidateSource candidate_source = source();
+    const auto batch_start = Clock::now();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (parallel_draws)
+    for (int k = 0; k < batch; ++k) {
+      const auto draw_start = Clock::now();
+      draws[static_cast<std::size_t>(k)] =
+          drawCandidate(candidate_source, config_.seed, generated + static_cast<std::uint64_t>(k), candidates_);
+      draw_seconds[static_cast<std::size_t>(k)] = secondsSince(draw_start);
+    }
+    if (parallel_draws) {
+      double serial_seconds = 0.0;
+      for (const double seconds : draw_seconds) serial_seconds += seconds;
+      parallel_draws = secondsSince(batch_start) < serial_seconds;
+    }
+    generated += static_cast<std::uint64_t>(batch);
+    bool any = false;
+    for (CandidateDraw& drawn : draws) {
+      if (drawn.duplicate_of >= 0) {
+        ++candidates_[static_cast<std::size_t>(drawn.duplicate_of)].multiplicity;
+      } else if (!drawn.candidate) {
+        continue;
+      } else if (drawn.candidate->score.score < min_score_) {
+        ++unlisted_;
+        ++stats.scored;
+      } else {
+        candidates_.push_back(std::move(*drawn.candidate));
+        ++stats.scored;
+      }
+      any = true;
+      ++stats.candidates;
+      ++since_acceptance_;
+    }
+    // No three neighbouring blocks agree any more: no candidate can be formed.
+    empty_batches = any ? 0 : empty_batches + 1;
+    if (empty_batches >= 4 || since_acceptance_ >= config_.max_idle_candidates) break;
+    // Lines 5–12: accept the best candidate while eq. 10 says a better one is
+    // unlikely to have been overlooked.
+    while (const auto best = bestCandidate()) {
+      if (acceptanceProbability(candidates_[*best]) < config_.min_probability) break;
+      const auto accept_start = Clock::now();
+      accept(*best);
+      stats.stages.patches += secondsSince(accept_start);
+      if (seedable_.size() - seedable_taken_ < 3) break;
+    }
+  }
+  stats.accepted = static_cast<std::size_t>(accepted_);
+  const auto describe_start = Clock::now();
+  describePatches();
+  stats.stages.patches += secondsSince(describe_start);
+  stats.stages.search = std::max(0.0, secondsSince(start) - stats.stages.patches);
+  const auto merge_start = Clock::now();
+  // Block points sit at cell centres (before format 3): pieces of one surface lie up to
+  // half a cell further apart than ε allows a block. Where they sit at their points, a
+  // piece further off than a sheet's step is another layer (sheets.hpp).
+  mergeCoplanar(grid_, patches_, std::min(config_.epsilon + 0.5 * grid_.cellSize(), sheet_step_),
+                radians(config_.kappa_deg));
+  stats.stages.merges = secondsSince(merge_start);
+  // Classification reads the outlines: the patches' and the merged groups' traced now.
+  const auto outline_start = Clock::now();
+  tracePendingOutlines(grid_, patches_, patchPassThreads(grid_, config_.threads));
+  stats.stages.patches += secondsSince(outline_start);
+  return std::move(patches_);
+}
+
+}  // namespace mlmap
