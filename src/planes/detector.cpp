@@ -32,7 +32,7 @@ int teamSize(int threads) {
 #endif
 }
 
-double sheetStep(double noise, double cell_size) { return std::max(3.0 * std::numbers::sqrt2 * noise, 0.5 * cell_size); }
+double sheetStep(double noise, double cell_size) { return std::max(3.0 * std::numbers::sqrt2 * noise, cell_size); }
 
 Detector::Detector(const BlockGrid& grid, const DirectionField& field, const ErmsmConfig& config, bool sheets)
     : grid_(grid),
@@ -157,7 +157,11 @@ SplitPatches Detector::splitSheets(const std::vector<std::uint32_t>& matching, c
   if (step >= 2.0 * config_.epsilon) {
     split = splitWithOutlineRuns(grid_, matching, normal, point, 2, patch_threads_);
   } else {
-    for (const std::vector<std::uint32_t>& sheet : sheetsOf(grid_, matching, plane, step, 2)) {
+    // Neighbours within 2 cells across, and in height within 2 cells or the stack gap
+    // (blocks of a cell closer than it are one block), whichever is more: at 2 cm cells
+    // blocks of one wall of the simulated lab lie further apart in height than 4 cm.
+    const double max_rise = std::max(2.0 * grid_.cellSize(), config_.stack_gap);
+    for (const std::vector<std::uint32_t>& sheet : sheetsOf(grid_, matching, plane, step, 2, max_rise)) {
       SplitPatches pieces = splitWithOutlineRuns(grid_, sheet, normal, point, 2, patch_threads_);
       for (std::size_t k = 0; k < pieces.patches.size(); ++k) {
         split.patches.push_back(std::move(pieces.patches[k]));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "id_set.hpp"
@@ -17,7 +18,8 @@ std::size_t rootOf(std::vector<std::uint32_t>& parent, std::size_t x) {
 }  // namespace
 
 std::vector<std::vector<std::uint32_t>> sheetsOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
-                                                 const CandidatePlane& plane, double step, int radius) {
+                                                 const CandidatePlane& plane, double step, int radius,
+                                                 double max_rise) {
   if (blocks.empty()) return {};
   IdSet members(grid.size());
   for (const std::uint32_t id : blocks) members.insert(id);
@@ -39,12 +41,18 @@ std::vector<std::vector<std::uint32_t>> sheetsOf(const BlockGrid& grid, const st
     const float high = block.vertical ? block.top : block.point.z();
     spans[k] = {distance - plane.normal.z() * block.point.z(), low, high};
   }
-  const auto difference = [&spans, &plane](std::size_t a, std::size_t b) {
+  // Blocks further apart in height than max_rise (a wall's foot and the top of the face
+  // behind it, 1.5 m up in the cell beside it) are not neighbours on any surface:
+  // infinitely different. Over such a rise the plane's tilt made fr079's 7 cm step look
+  // like 5, where a candidate leaning between two faces fitted both.
+  const auto reach = static_cast<float>(max_rise);
+  const auto difference = [&spans, &plane, reach](std::size_t a, std::size_t b) {
     const Span& first = spans[a];
     const Span& second = spans[b];
     float dz = 0.0F;  // the height of b's closest point minus a's
     if (second.bottom > first.top) dz = second.bottom - first.top;
     if (first.bottom > second.top) dz = second.top - first.bottom;
+    if (std::abs(dz) > reach) return std::numeric_limits<float>::infinity();
     return std::abs(second.level - first.level + plane.normal.z() * dz);
   };
   std::vector<std::uint32_t> parent(blocks.size());

@@ -17,9 +17,11 @@
 namespace mlmap {
 
 // `blocks` (ascending) in groups connected through pairs of blocks in cells at most
-// `radius` apart (Chebyshev) whose distances from the plane differ by at most `step`;
-// each group ascending, in the order of their first block.
+// `radius` apart (Chebyshev) and at most `max_rise` apart in height whose distances
+// from the plane, compared at their closest points, differ by at most `step`; each group
+// ascending, in the order of their first block.
 std::vector<std::vector<std::uint32_t>> sheetsOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
-                                                 const CandidatePlane& plane, double step, int radius);
+                                                 const CandidatePlane& plane, double step, int radius,
+                                                 double max_rise);
 
 }  // namespace mlmap
