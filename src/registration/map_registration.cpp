@@ -1,7 +1,7 @@
 #include "mlmap/registration/map_registration.hpp"
 
-#include <algorithm>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -12,11 +12,6 @@
 namespace mlmap::registration {
 namespace {
 
-// Samples of the surfaces the blocks describe, as blockSurfacePoints (a horizontal block's
-// height; a vertical block's extent every `spacing` m), but placed at the mean x, y of the
-// points each block collected where it kept them (format 3 maps): at cell centres a wall is
-// quantised to the grid, which bounds the match to about half a cell (merged rooms 2-8 cm
-// off at 0.1 m cells, bench/merge_register.py tune split).
 // m, added to the first gate from the walls' start: what a yaw error of the walls' estimate
 // (within 1.3 deg of the truth on the stress benchmark's tune split) moves points at a
 // room's 4-5 m reach.
@@ -39,6 +34,11 @@ Pose levelledAbout(const Pose& pose, const std::vector<Point>& samples) {
   return levelled;
 }
 
+// Samples of the surfaces the blocks describe, as blockSurfacePoints (a horizontal block's
+// height; a vertical block's extent every `spacing` m), but placed at the mean x, y of the
+// points each block collected where it kept them (format 3 maps): at cell centres a wall is
+// quantised to the grid, which bounds the match to about half a cell (merged rooms 2-8 cm
+// off at 0.1 m cells, bench/merge_register.py tune split).
 std::vector<Point> surfaceSamples(const MLMap& blocks, double spacing) {
   std::vector<Point> points;
   points.reserve(blocks.blockCount());
@@ -124,6 +124,8 @@ MapRegistration registerMaps(const Map& base, const Map& other, const Pose& init
 
   MapRegistration registration;
   registration.other_to_base = levelledAbout(result.pose, source);
+  const Eigen::Vector3d up = result.pose.linear() * Eigen::Vector3d::UnitZ();
+  registration.tilt_deg = std::acos(std::clamp(up.z(), -1.0, 1.0)) * 180.0 / std::numbers::pi;
   registration.rms_residual = result.rms_residual;
   registration.inliers = result.inliers;
   registration.samples = source.size();
@@ -152,6 +154,9 @@ MapRegistration registerMaps(const Map& base, const Map& other, const Pose& init
     registration.reason = "too few ICP inliers (" + std::to_string(result.inliers) + ")";
   } else if (!verified.verified) {
     registration.reason = verified.reason;
+  } else if (registration.tilt_deg > config.max_tilt_deg) {
+    registration.reason = "the match tilts the other map by " + std::to_string(registration.tilt_deg) +
+                          " deg: the maps are gravity-aligned (limit " + std::to_string(config.max_tilt_deg) + " deg)";
   } else if (!result.converged) {
     registration.reason = "ICP did not converge";
   }
