@@ -53,16 +53,19 @@ int runMerge(const MergeArguments& arguments, bool quiet) {
     const Pose initial = arguments.initial.empty() ? Pose::Identity() : io::readTransform(arguments.initial);
     if (!quiet) std::fprintf(stderr, "merge: registering the maps (ICP) ...\n");
     const auto icp_start = std::chrono::steady_clock::now();
-    const registration::MapRegistration found = registration::registerMaps(base, other, initial);
+    registration::MapRegistrationConfig config;
+    config.max_tilt_deg = arguments.max_tilt_deg;
+    const registration::MapRegistration found = registration::registerMaps(base, other, initial, config);
     printTransform("initial guess", initial);
     printTransform("registered   ", found.other_to_base);
     std::printf("  ICP: %zu of %zu surface samples matched, RMS %.2f cm, overlap %.1f %%, %.2f s%s\n", found.inliers,
                 found.samples, 100.0 * found.rms_residual, 100.0 * found.overlap, seconds(icp_start),
                 found.reliable ? "" : " — UNRELIABLE");
     std::printf("  verification: %s, %.0f %% of the samples explained, residual spread %.2f cm (surface noise %.2f cm), "
-                "%d ICP run%s\n",
+                "%d ICP run%s, %.2f° of tilt levelled\n",
                 found.verified ? "verified" : "NOT VERIFIED", 100.0 * found.explained_share,
-                100.0 * found.residual_spread, 100.0 * found.noise, found.attempts, found.attempts == 1 ? "" : "s");
+                100.0 * found.residual_spread, 100.0 * found.noise, found.attempts, found.attempts == 1 ? "" : "s",
+                found.tilt_deg);
     if (!found.reliable) {
       if (!arguments.force) {
         throw Error("registration unreliable: " + found.reason +

@@ -79,12 +79,15 @@ int runRegister(RegisterOptions options, bool quiet) {
     const auto start = std::chrono::steady_clock::now();
     refinement = sequence.refine();
     refine_seconds = secondsSince(start);
-    std::printf("refinement: %zu verified pair edges (%zu loop closures, %zu pairs rejected), graph cost %.4g -> %.4g, "
-                "pair residual RMS %.2f -> %.2f cm (%s) in %.2f s\n",
-                refinement.pair_edges, refinement.loop_edges, refinement.rejected_pairs, refinement.graph.initial_cost,
-                refinement.graph.final_cost, 100.0 * std::sqrt(refinement.residual_before),
+    std::printf("refinement: %zu verified pair edges (%zu loop closures, %zu pairs rejected, %zu of them unconstrained), "
+                "graph cost %.4g -> %.4g, residual against the other scans RMS %.3f -> %.3f cm (%s) in %.2f s\n",
+                refinement.pair_edges, refinement.loop_edges, refinement.rejected_pairs, refinement.unconstrained_pairs,
+                refinement.graph.initial_cost, refinement.graph.final_cost, 100.0 * std::sqrt(refinement.residual_before),
                 100.0 * std::sqrt(refinement.residual_after),
-                refinement.rounds_applied > 0 ? "applied" : "kept the scan-to-map poses: the graph did not lower it",
+                refinement.rounds_applied > 0 ? "applied"
+                : refinement.pair_edges == 0 ? "kept the scan-to-map poses: no verified pair"
+                : refinement.scans_worse > 0 ? "kept the scan-to-map poses: the graph's made a scan worse"
+                                             : "kept the scan-to-map poses: the graph's did not clearly lower it",
                 refine_seconds);
   }
   if (!options.report.empty()) writeRegisterReport(options.report, reports, options.no_refine ? nullptr : &refinement);

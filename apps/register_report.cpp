@@ -77,10 +77,13 @@ void writeRegisterReport(const std::string& path, const std::vector<ScanReport>&
     out["refinement"] = {{"pair_edges", refinement->pair_edges},
                          {"loop_edges", refinement->loop_edges},
                          {"rejected_pairs", refinement->rejected_pairs},
+                         {"unconstrained_pairs", refinement->unconstrained_pairs},
                          {"graph_cost_initial", refinement->graph.initial_cost},
                          {"graph_cost_final", refinement->graph.final_cost},
-                         {"pair_residual_before_m2", refinement->residual_before},
-                         {"pair_residual_after_m2", refinement->residual_after},
+                         {"scan_residual_before_m2", refinement->residual_before},
+                         {"scan_residual_after_m2", refinement->residual_after},
+                         {"residual_change_sigmas", refinement->residual_change_sigmas},
+                         {"scans_worse", refinement->scans_worse},
                          {"rounds_applied", refinement->rounds_applied}};
   }
   io::writeAtomically(path, [&](std::ostream& stream) { stream << out.dump(1) << '\n'; });

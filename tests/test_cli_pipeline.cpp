@@ -4,6 +4,7 @@
 
 #include <fstream>
 #include <set>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
@@ -136,11 +137,24 @@ TEST_CASE("CLI: merge with a transform, by registration, and refused without ove
   const auto direct_blocks = mlmap::io::readMap(rooms.map).blocks().blockCount();
   CHECK(static_cast<double>(merged_blocks) < 1.15 * static_cast<double>(direct_blocks));
 
-  // The east map moved 40 m away: ICP from the identity finds nothing to match.
-  mlmap::test::writeText(rooms.dir / "far.txt", "40 0 0 0\n");
+  // The east map built 40 m away (its poses moved along x): ICP from the identity finds
+  // nothing to match. (A map merged into west at +40 m would hold west itself at the identity.)
+  std::ifstream east_poses(rooms.dir / "east_poses.txt");
+  std::string far_poses;
+  for (std::string line; std::getline(east_poses, line);) {
+    std::istringstream fields(line);
+    double stamp = 0.0;
+    double x = 0.0;
+    fields >> stamp >> x;
+    std::string rest;
+    std::getline(fields, rest);
+    far_poses += std::to_string(stamp) + " " + std::to_string(x + 40.0) + rest + "\n";
+  }
+  mlmap::test::writeText(rooms.dir / "far_poses.txt", far_poses);
   const fs::path far = rooms.dir / "far.mlmap";
-  result = runCli("--quiet merge " + rooms.west.string() + " " + rooms.east.string() + " --transform " +
-                  (rooms.dir / "far.txt").string() + " -o " + far.string());
+  const auto east_scan = [&](int k) { return (rooms.dir / "sim" / ("scan_00" + std::to_string(k) + ".xyz")).string(); };
+  result = runCli("--quiet build --cell-size 0.05 --max-range 12 --no-octree -o " + far.string() + " --poses " +
+                  (rooms.dir / "far_poses.txt").string() + " " + east_scan(2) + " " + east_scan(3));
   REQUIRE_MESSAGE(result.exit_code == 0, result.output);
   const fs::path refused = rooms.dir / "refused.mlmap";
   result = runCli("--quiet merge " + rooms.west.string() + " " + far.string() + " --register -o " + refused.string());

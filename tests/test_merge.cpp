@@ -109,17 +109,20 @@ TEST_CASE("Merge: ICP places the other room, the shared walls become one plane, 
 TEST_CASE("Merge: ICP places the other room from the identity, frames up to 1 m and 30 degrees apart") {
   // Rooms mapped apart share no frame: no --initial, the start is the identity.
   const Map base = mapOf({0, 1}, Pose::Identity(), false);
-  // One frame (the -22 deg frame, which needs the yaw retries, costs 4 wide ICP runs on
-  // 10 000 map points: bench/icp_stress.py holds the many-start cases).
-  for (const Pose& b_frame : {yawPose(0.7, -0.6, 0.0, 28.0)}) {
+  // The -22 deg frame is the hard one: from the identity the yaw retries took 5 wide ICP runs
+  // (8 s) before the walls' dominant directions gave the start (bench/merge_register.py holds
+  // the many generated cases). The issue's figure: within 2 cm and 0.2 deg.
+  for (const Pose& b_frame : {yawPose(0.7, -0.6, 0.0, 28.0), yawPose(-0.5, 0.8, 0.0, -22.0)}) {
     CAPTURE(yawDeg(b_frame));
     const Map other = mapOf({2, 3}, b_frame, false);
     const registration::MapRegistration found = registration::registerMaps(base, other, Pose::Identity());
     INFO("reason: " << found.reason);
     CHECK(found.reliable);
     CHECK(found.verified);
-    CHECK((found.other_to_base.translation() - b_frame.translation()).norm() < 0.03);
-    CHECK(std::abs(yawDeg(found.other_to_base) - yawDeg(b_frame)) < 0.3);
+    CHECK((found.other_to_base.translation() - b_frame.translation()).norm() < 0.02);
+    CHECK(std::abs(yawDeg(found.other_to_base) - yawDeg(b_frame)) < 0.2);
+    CAPTURE(found.attempts);
+    CHECK(found.attempts <= 2);
   }
 }
 
