@@ -13,7 +13,7 @@ range noise (as bench/planes_bench.py). Each round runs `mlmap planes --threads 
 map in turn (so a busy spell of the shared machine falls on all maps alike); --repeat rounds.
 Per map: the best and the median seconds (the planes JSON's total_s: everything after reading
 the map), microseconds per map block (best / median), the median against the lab's at the same
-cell size, the median of every stage in microseconds per block (`first` is the noise stage: where
+cell size, the candidate planes drawn (by the last pass; each is scored and refitted up to 5 times), the median of every stage in microseconds per block (`first` is the noise stage: where
 the planes measure σ and it moves ε or the level band, the whole first detection, then detected
 again: `passes` 2), and with --peers CGAL's normals + detection on the scene's points (best of
 --repeat; the points are the ones mlmap maps, so CGAL's time per point stands beside mlmap's).
@@ -86,7 +86,7 @@ def table(maps, runs, cgal):
         if name == "sim lab":
             j = runs[path]
             lab[cell] = statistics.median(r["timings"]["total_s"] for r in j) / j[0]["map"]["blocks"]
-    head = ("| scene | cell m | points | blocks | passes | s best / median | µs/block best / median | × lab | " +
+    head = ("| scene | cell m | points | blocks | candidates | passes | s best / median | µs/block best / median | × lab | " +
             " | ".join(STAGE_NAMES) + " | CGAL s | CGAL / mlmap |")
     lines = [head, "|---" * (head.count("|") - 1) + "|"]
     for name, cell, path, points in maps:
@@ -98,7 +98,8 @@ def table(maps, runs, cgal):
                             for s in STAGES)
         versus_lab = f"{median / blocks / lab[cell]:.1f}" if cell in lab else "-"
         peer = f"{cgal[name]:.2f} | {cgal[name] / median:.1f}" if name in cgal else "- | -"
-        lines.append(f"| {name} | {cell:g} | {points} | {blocks} | {j[0]['detection'].get('passes', '?')} | "
+        lines.append(f"| {name} | {cell:g} | {points} | {blocks} | {j[0]['detection']['candidates']} | "
+                     f"{j[0]['detection'].get('passes', '?')} | "
                      f"{best:.3f} / {median:.3f} | {1e6 * best / blocks:.2f} / {1e6 * median / blocks:.2f} | "
                      f"{versus_lab} | {stages} | {peer} |")
     return "\n".join(lines) + "\n"
