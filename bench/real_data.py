@@ -122,16 +122,38 @@ def score(labels, owner, points, planes, annotation):
                       stray_patches=len(stray), stray_points=int(np.isin(labels, stray).sum()))
 
 
-def run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features, planes_args=()):
+def posed_options(pose_file, features):
+    """World-frame clouds (no sensor pose) are mapped as they are: --identity where the CLI asks for it."""
+    return ["--poses", pose_file] if pose_file else (["--identity"] if "--identity" in features["build"] else [])
+
+
+def build_map(mlmap, folder, cell, files, pose_file, up_options, features):
+    """The block layer of the scene at this cell size (FOLDER/cellC.mlmap); returns (path, build seconds)."""
     tag = os.path.join(folder, f"cell{cell:g}")
-    # World-frame clouds (no sensor pose) are mapped as they are: --identity where the CLI
-    # asks for it. The benchmark drops a scanner's own and no-return readings itself
-    # (real_clouds.py), so mlmap's range limits are opened wide.
-    posed = ["--poses", pose_file] if pose_file else (["--identity"] if "--identity" in features["build"] else [])
+    # The benchmark drops a scanner's own and no-return readings itself (real_clouds.py),
+    # so mlmap's range limits are opened wide.
     wide = (["--max-range", "1000"] if "--max-range" in features["build"] else []) + \
            (["--min-range", "0"] if "--min-range" in features["build"] else [])
-    build = [mlmap, "-q", "build", "-o", tag + ".mlmap", "--cell-size", str(cell), "--no-octree"] + posed + up_options + wide
+    build = [mlmap, "-q", "build", "-o", tag + ".mlmap", "--cell-size", str(cell), "--no-octree"] + \
+        posed_options(pose_file, features) + up_options + wide
     _, build_s = run(build + files)
+    return tag + ".mlmap", build_s
+
+
+def scene_inputs(mlmap, scene, folder, features):
+    """The scene's .xyz files, its pose file (registered first where the scene asks) and up options."""
+    files, pose_file, up_options = write_inputs(scene, folder, "--up" in features["build"])
+    if scene.register:
+        registered = os.path.join(folder, "registered.tum")
+        run([mlmap, "-q", "register", "-o", registered, "--poses", pose_file] + files)
+        pose_file = registered
+    return files, pose_file, up_options
+
+
+def run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features, planes_args=()):
+    tag = os.path.join(folder, f"cell{cell:g}")
+    posed = posed_options(pose_file, features)
+    _, build_s = build_map(mlmap, folder, cell, files, pose_file, up_options, features)
     run([mlmap, "-q", "planes", tag + ".mlmap", "--threads", "2", "-o", tag + ".planes.mlmap", "--json", tag + ".planes.json"] + list(planes_args))
     planes_json = json.load(open(tag + ".planes.json"))
     label = [mlmap, "-q", "label", tag + ".planes.mlmap", "-o", tag + ".labels.xyz"] + posed
@@ -272,11 +294,7 @@ def main():
         os.makedirs(folder, exist_ok=True)
         world = scene.world()
         owner = real_annotations.memberships(world, annotation)
-        files, pose_file, up_options = write_inputs(scene, folder, "--up" in features["build"])
-        if scene.register:
-            registered = os.path.join(folder, "registered.tum")
-            run([mlmap, "-q", "register", "-o", registered, "--poses", pose_file] + files)
-            pose_file = registered
+        files, pose_file, up_options = scene_inputs(mlmap, scene, folder, features)
         results, labelled = {}, {}
         for cell in cells:
             points, labels, planes, times = run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features,

@@ -100,9 +100,12 @@ TEST_CASE("PlanesJson: an export reads back to the same planes") {
   // tolerance by the larger of the two.
   PlaneDetection measured = detection;
   measured.stats.prior_noise = 0.03;
-  CHECK(io::parsePlanesJson(io::planesJson(map, measured, "room.mlmap"), "room.json").stats.prior_noise ==
-        doctest::Approx(0.03));
+  measured.stats.passes = 2;
+  const PlaneDetection measured_back = io::parsePlanesJson(io::planesJson(map, measured, "room.mlmap"), "room.json");
+  CHECK(measured_back.stats.prior_noise == doctest::Approx(0.03));
+  CHECK(measured_back.stats.passes == 2);
   CHECK(back.stats.prior_noise == doctest::Approx(detection.stats.prior_noise));
+  CHECK(back.stats.passes == detection.stats.passes);
 }
 
 TEST_CASE("PlanesJson: a plane per line, outline corners and centroids to the micrometre") {

@@ -77,7 +77,8 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
                        {"scored", run.scored},
                        {"accepted", run.accepted},
                        {"labelled_blocks", run.labelled_blocks},
-                       {"blocks_with_direction", run.blocks_with_direction}};
+                       {"blocks_with_direction", run.blocks_with_direction},
+                       {"passes", run.passes}};
   // σ the build assumed, where the planes measured parameters.noise on a first pass.
   if (run.prior_noise > 0.0) json["parameters"]["assumed_noise"] = asFloat(run.prior_noise);
   json["timings"] = {{"direction_vectors_s", run.direction_seconds},

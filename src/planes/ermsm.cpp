@@ -184,6 +184,7 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   const double first_pass_seconds = secondsSince(start);
   detection = detectOnce(map, again, block_noise, true);
   if (again.noise != config.noise) detection.stats.prior_noise = config.noise;
+  detection.stats.passes = 2;
   chargeNoise(detection, first_pass_seconds);
   return detection;
 }

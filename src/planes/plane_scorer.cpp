@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <type_traits>
 
 #include "counting_sort.hpp"
 #include "id_set.hpp"
@@ -56,6 +57,9 @@ const BinLayout& binLayout() {
 
 int binCount() { return binLayout().first[kElevationRows]; }
 
+// The sine of a cone's radius from its cosine, as the cone test once computed it per query.
+float sineOf(float cos_r) { return std::sqrt(std::max(0.0F, 1.0F - cos_r * cos_r)); }
+
 // Above this |z| a direction's elevation is surely in the top row (80° and up: sin 80°
 // = 0.98481), which is one bin whatever the azimuth: floors and ceilings, most blocks
 // of a building, skip the trigonometry and land where it would put them.
@@ -88,7 +92,7 @@ struct PlaneScorer::Query {
     const float cos_t = std::min(1.0F, std::abs(node.axis.dot(normal)));
     const float sin_t = std::sqrt(std::max(0.0F, 1.0F - cos_t * cos_t));
     const float cos_r = node.cos_radius;
-    const float sin_r = std::sqrt(std::max(0.0F, 1.0F - cos_r * cos_r));
+    const float sin_r = node.sin_radius;
     if (cos_t * cos_r - sin_t * sin_r > cos_kappa + kCosMargin) return Cone::Inside;  // t + ρ < κ
     if (cos_t < cos_r && cos_t * cos_r + sin_t * sin_r < cos_kappa - kCosMargin) return Cone::Outside;  // t − ρ > κ
     return Cone::Cut;
@@ -320,6 +324,7 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
     for (std::uint32_t k = node.begin; k < node.end; ++k) {
       node.cos_radius = std::min(node.cos_radius, std::abs(node.axis.dot(block_directions_[k])));
     }
+    node.sin_radius = sineOf(node.cos_radius);
     return extent;
   };
   auto fromChildren = [&](Node& node, const Frame& frame, const std::vector<Node>& children,
@@ -342,6 +347,7 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
       node.cos_radius = std::min(node.cos_radius, cos_apart * cos_child - sin_apart * sin_child - 1e-6F);
     }
     node.cos_radius = std::max(0.0F, node.cos_radius);
+    node.sin_radius = sineOf(node.cos_radius);
     return extent;
   };
   const auto layer_count_signed = static_cast<std::int64_t>(layers_.size());
@@ -365,6 +371,13 @@ PlaneScorer::PlaneScorer(const BlockGrid& grid, const std::vector<Eigen::Vector3
   for (std::size_t b = 0; b < bins; ++b) {
     if (bins_[b].begin != bins_[b].end) fromChildren(bins_[b], frames_[b], layers_, layer_extents);
   }
+  live_tiles_.resize(tiles_.size());
+  for (std::uint32_t t = 0; t < tiles_.size(); ++t) {
+    const Node& tile = tiles_[t];
+    live_tiles_[t] = LiveTile{tile.axis, tile.cos_radius, tile.centre, tile.sin_radius, tile.half_extent, t};
+  }
+  live_end_.resize(layers_.size());
+  for (std::size_t l = 0; l < layers_.size(); ++l) live_end_[l] = layers_[l].end;
   std::vector<std::uint32_t> all_tiles(tiles_.size());
   for (std::uint32_t t = 0; t < tiles_.size(); ++t) all_tiles[t] = t;
   sumLayersAndBins(all_tiles);
@@ -418,9 +431,19 @@ void PlaneScorer::sumLayersAndBins(const std::vector<std::uint32_t>& tiles) {
   std::vector<std::uint32_t> bins;
   for (const std::uint32_t l : layers) {
     sumChildren(layers_[l], tiles_);
+    dropTakenTiles(l);
     if (bins.empty() || bins.back() != bin_of_layer_[l]) bins.push_back(bin_of_layer_[l]);
   }
   for (const std::uint32_t b : bins) sumChildren(bins_[b], layers_);
+}
+
+// Keeps the layer's live run to the tiles that still hold untaken blocks, in order.
+void PlaneScorer::dropTakenTiles(std::uint32_t layer) {
+  std::uint32_t kept = layers_[layer].begin;
+  for (std::uint32_t n = layers_[layer].begin; n < live_end_[layer]; ++n) {
+    if (tiles_[live_tiles_[n].tile].untaken != 0) live_tiles_[kept++] = live_tiles_[n];
+  }
+  live_end_[layer] = kept;
 }
 
 PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
@@ -445,11 +468,15 @@ PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
     }
   };
   // Decides a node from its parent's verdicts; returns false when nothing inside remains to open.
-  auto decide = [&](const Node& node, const Eigen::Vector3f& frame_normal, Cone& cone, Slab& slab) {
-    if (node.untaken == 0) return false;
-    if (cone == Cone::Cut) cone = query.cone(node);
+  // `shape`: the node itself, or a live tile's copy of its cone and box.
+  auto decide = [&](const auto& shape, const Node& node, const Eigen::Vector3f& frame_normal, Cone& cone, Slab& slab) {
+    // A live tile has untaken blocks (and its node need not be read unless counted).
+    if constexpr (!std::is_same_v<std::decay_t<decltype(shape)>, LiveTile>) {
+      if (node.untaken == 0) return false;
+    }
+    if (cone == Cone::Cut) cone = query.cone(shape);
     if (cone == Cone::Outside) return false;
-    if (slab == Slab::Cut) slab = query.slab(node, frame_normal);
+    if (slab == Slab::Cut) slab = query.slab(shape, frame_normal);
     if (cone == Cone::Inside) {
       result.similar += node.surface;
       if (slab == Slab::Outside) return false;
@@ -467,7 +494,7 @@ PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
                                        std::abs(frame.v.dot(query.normal)));
     Cone bin_cone = Cone::Cut;
     Slab bin_slab = Slab::Cut;
-    if (!decide(bins_[b], frame_normal, bin_cone, bin_slab)) continue;
+    if (!decide(bins_[b], bins_[b], frame_normal, bin_cone, bin_slab)) continue;
     for (std::uint32_t l = bins_[b].begin; l < bins_[b].end; ++l) {
       Cone layer_cone = bin_cone;
       Slab layer_slab = bin_slab;
@@ -481,25 +508,25 @@ PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
           whole(layer);
           continue;
         }
-      } else if (!decide(layers_[l], frame_normal, layer_cone, layer_slab)) {
+      } else if (!decide(layers_[l], layers_[l], frame_normal, layer_cone, layer_slab)) {
         continue;
       }
-      for (std::uint32_t t = layers_[l].begin; t < layers_[l].end; ++t) {
+      // The untaken tiles only: the others add nothing.
+      for (std::uint32_t n = layers_[l].begin; n < live_end_[l]; ++n) {
         Cone tile_cone = layer_cone;
         Slab tile_slab = layer_slab;
-        const Node& tile = tiles_[t];
+        const LiveTile& live = live_tiles_[n];
         if (layer_cone == Cone::Inside) {
-          if (tile.untaken == 0) continue;
-          if (tile_slab == Slab::Cut) tile_slab = query.slab(tile, frame_normal);
+          if (tile_slab == Slab::Cut) tile_slab = query.slab(live, frame_normal);
           if (tile_slab == Slab::Outside) continue;
           if (tile_slab == Slab::Inside) {
-            whole(tile);
+            whole(tiles_[live.tile]);
             continue;
           }
-        } else if (!decide(tile, frame_normal, tile_cone, tile_slab)) {
+        } else if (!decide(live, tiles_[live.tile], frame_normal, tile_cone, tile_slab)) {
           continue;
         }
-        blocks(tile, tile_cone, tile_slab);
+        blocks(tiles_[live.tile], tile_cone, tile_slab);
       }
     }
   }
@@ -548,14 +575,15 @@ void PlaneScorer::collect(const Query& query, const Query* except, IdSet& ids) c
     for (std::uint32_t l = bin.begin; l < bin.end; ++l) {
       const Node& layer = layers_[l];
       if (layer.untaken == 0 || query.slab(layer, frame_normal) == Slab::Outside) continue;
-      for (std::uint32_t t = layer.begin; t < layer.end; ++t) {
-        const Node& tile = tiles_[t];
-        if (tile.untaken == 0 || query.slab(tile, frame_normal) == Slab::Outside) continue;
-        const Cone cone = query.cone(tile);
+      for (std::uint32_t n = layer.begin; n < live_end_[l]; ++n) {
+        const LiveTile& live = live_tiles_[n];
+        if (query.slab(live, frame_normal) == Slab::Outside) continue;
+        const Cone cone = query.cone(live);
         if (cone == Cone::Outside) continue;
-        if (except != nullptr && except->cone(tile) == Cone::Inside && except->slab(tile, frame_normal) == Slab::Inside) {
+        if (except != nullptr && except->cone(live) == Cone::Inside && except->slab(live, frame_normal) == Slab::Inside) {
           continue;
         }
+        const Node& tile = tiles_[live.tile];
         for (std::uint32_t k = tile.begin; k < tile.end; ++k) {
           if (order_taken_[k] != 0) continue;
           if (cone == Cone::Cut && std::abs(block_directions_[k].dot(query.normal)) < query.cos_kappa) continue;

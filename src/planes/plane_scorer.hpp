@@ -62,11 +62,23 @@ class PlaneScorer {
     std::uint32_t end = 0;
     Eigen::Vector3f axis = Eigen::Vector3f::UnitZ();  // unit mean direction of its blocks
     float cos_radius = 1.0F;                          // cosine of the widest member direction from the axis
+    float sin_radius = 0.0F;                          // its sine (kept: every query's cone test needs it)
     Eigen::Vector3f centre = Eigen::Vector3f::Zero();       // m, of its points' box
     Eigen::Vector3f half_extent = Eigen::Vector3f::Zero();  // m, of the box along its bin's frame
     std::uint32_t untaken = 0;
     double surface = 0.0;  // untaken surface
     PcaSums pca;           // untaken blocks, relative to centre
+  };
+  // What a query tests of a tile, for the tiles that still hold untaken blocks: a
+  // score passes over half the tiles of a real scan's clutter, most of them taken or
+  // outside, and these 48 bytes are what it reads of each.
+  struct LiveTile {
+    Eigen::Vector3f axis;
+    float cos_radius;
+    Eigen::Vector3f centre;
+    float sin_radius;
+    Eigen::Vector3f half_extent;
+    std::uint32_t tile;  // index in tiles_
   };
   struct Frame {
     Eigen::Vector3f a, u, v;  // the bin's axis and two directions across it
@@ -78,6 +90,7 @@ class PlaneScorer {
   void sumTile(Node& tile) const;
   void refresh(const std::vector<std::uint32_t>& tiles);
   void sumLayersAndBins(const std::vector<std::uint32_t>& tiles);
+  void dropTakenTiles(std::uint32_t layer);
   void collect(const Query& query, const Query* except, IdSet& ids) const;
 
   const BlockGrid& grid_;
@@ -89,6 +102,10 @@ class PlaneScorer {
   std::vector<Frame> frames_; // per bin
   std::vector<Node> layers_;  // children: tiles
   std::vector<Node> tiles_;   // children: blocks
+  // A layer's untaken tiles, ascending, are live_tiles_[layers_[l].begin, live_end_[l]):
+  // a tile once taken never returns, so each run only shrinks.
+  std::vector<LiveTile> live_tiles_;
+  std::vector<std::uint32_t> live_end_;  // per layer
   // Blocks ordered by bin, layer, tile, id (structure of arrays: a pass streams).
   FillVector<std::uint32_t> ids_;
   FillVector<Eigen::Vector3f> points_;

@@ -85,6 +85,7 @@ struct ErmsmStats {
   // m: where σ was measured on a first pass's planes (see detectPlanes), that pass's σ;
   // 0 where one pass sufficed
   double prior_noise = 0.0;
+  int passes = 1;                   // detections run: 2 where σ was measured on a first pass's planes
   double direction_seconds = 0.0;   // noise estimate, eRMSM blocks and direction vectors
   double detection_seconds = 0.0;   // Algorithm 1 with refits, patch split, merges, classes, labels
   ErmsmStageSeconds stages;         // both, split further
