@@ -114,7 +114,8 @@ void associateAndBuild(const std::vector<Point>& source, const VoxelHashMap& tar
   // A pass that searches few points (the coarse stage) or none (reuse) takes a millisecond
   // or two: alone it beats paying a fork-join, which on a busy machine can wait out another
   // job's time slice.
-  const std::size_t searched = search == Search::Reuse ? 0 : source.size() / static_cast<std::size_t>(stride);
+  [[maybe_unused]] const std::size_t searched =
+      search == Search::Reuse ? 0 : source.size() / static_cast<std::size_t>(stride);
 #pragma omp parallel for schedule(dynamic, 4) if (searched >= kParallelSearches)
   for (long b = 0; b < static_cast<long>(blocks); ++b) {
     LinearSystem& system = partial[static_cast<std::size_t>(b)];
