@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "mlmap/map/ml_map.hpp"
+#include "mlmap/map/surface_points.hpp"
 #include "mlmap/registration/preprocessing.hpp"
 #include "mlmap/registration/wall_yaw.hpp"
 
@@ -34,26 +35,6 @@ Pose levelledAbout(const Pose& pose, const std::vector<Point>& samples) {
   return levelled;
 }
 
-// Samples of the surfaces the blocks describe, as blockSurfacePoints (a horizontal block's
-// height; a vertical block's extent every `spacing` m), but placed at the mean x, y of the
-// points each block collected where it kept them (format 3 maps): at cell centres a wall is
-// quantised to the grid, which bounds the match to about half a cell (merged rooms 2-8 cm
-// off at 0.1 m cells, bench/merge_register.py tune split).
-std::vector<Point> surfaceSamples(const MLMap& blocks, double spacing) {
-  std::vector<Point> points;
-  points.reserve(blocks.blockCount());
-  for (std::size_t n = 0; n < blocks.cellCount(); ++n) {
-    const Eigen::Vector2d centre = blocks.cellCenter(blocks.cellAt(n));
-    for (const Block& block : blocks.blocksAt(n)) {
-      Eigen::Vector2d xy = centre;
-      if (!block.points.empty()) xy += Eigen::Vector2d(block.points.mean_x, block.points.mean_y);
-      const auto steps = static_cast<int>(std::floor(block.depth / spacing));
-      for (int k = 0; k <= steps; ++k) points.emplace_back(xy.x(), xy.y(), block.height - k * spacing);
-    }
-  }
-  return points;
-}
-
 }  // namespace
 
 MapRegistration registerMaps(const Map& base, const Map& other, const Pose& initial_guess,
@@ -62,11 +43,16 @@ MapRegistration registerMaps(const Map& base, const Map& other, const Pose& init
   // Voxels of a few cells: enough points per voxel for normals, few enough for speed.
   const double voxel_size = std::max(0.1, 2.0 * cell_size);
   const NormalConfig normals{std::max(0.25, 3.0 * cell_size), 6, 0.05};
-  const std::vector<Point> target_samples = surfaceSamples(base.blocks(), cell_size);
+  // Samples at the mean x, y of each block's points: at cell centres a wall is quantised
+  // to the grid, which bounds the match to about half a cell (merged rooms 2-8 cm off at
+  // 0.1 m cells, bench/merge_register.py tune split).
+  const std::vector<Point> target_samples =
+      blockSurfacePoints(base.blocks(), cell_size, SamplePlace::PointMean);
   VoxelHashMap target(voxel_size);
   target.addPoints(target_samples);
   target.estimateNormals(normals);
-  const std::vector<Point> other_samples = surfaceSamples(other.blocks(), other.config().cell_size);
+  const std::vector<Point> other_samples =
+      blockSurfacePoints(other.blocks(), other.config().cell_size, SamplePlace::PointMean);
   const std::vector<Point> source = voxelDownSample(other_samples, voxel_size);
 
   IcpConfig icp;

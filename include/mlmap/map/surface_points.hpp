@@ -8,8 +8,16 @@
 
 namespace mlmap {
 
-// At each cell centre: a horizontal block's height, and a vertical block's extent from
-// its top down every `spacing` metres.
-std::vector<Point> blockSurfacePoints(const MLMap& blocks, double spacing);
+// Where in its cell a block's samples stand.
+enum class SamplePlace {
+  CellCentre,  // the cell's centre (the grid's own quantisation)
+  PointMean,   // the mean x, y of the points the block collected where it kept them
+               // (format 3 maps), else the cell's centre
+};
+
+// A horizontal block's height, and a vertical block's extent from its top down every
+// `spacing` metres, each at `place` in its cell.
+std::vector<Point> blockSurfacePoints(const MLMap& blocks, double spacing,
+                                      SamplePlace place = SamplePlace::CellCentre);
 
 }  // namespace mlmap
