@@ -39,21 +39,10 @@ inline int patchPassThreads(const BlockGrid& grid, int threads) { return grid.si
 // The threads an OpenMP region of `threads` (0: OpenMP's default) gets.
 int teamSize(int threads);
 
-// m: the most two neighbouring blocks of one sheet (sheets.hpp) may differ by in their
-// distance from their plane: 3 standard deviations of the difference of two points'
-// noise, 3 √2 σ, and at least a cell: a block is the mean of what its cell holds, and
-// where that is a surface's edge or a second surface (a wall's foot, a corner) the mean
-// moves by up to half a cell, two neighbours' in opposite directions. Measured: the
-// simulated lab (4 mm noise) at 10 cm cells lost 0.09 don't-care F1 with 3 √2 σ alone
-// and at 2 cm 0.02-0.05 with half a cell; with a cell neither, and fr079's faces (8-10 cm
-// apart) still part at 5 cm cells (at 10 cm they no longer do).
-double sheetStep(double noise, double cell_size);
-
 class Detector {
  public:
   // `sheets`: cut planes into sheets (the blocks keep their points' moments, σ is known).
   Detector(const BlockGrid& grid, const DirectionField& field, const ErmsmConfig& config, bool sheets);
-
 
   // Algorithm 1; the patches it leaves, coplanar pieces merged.
   PatchSet run(ErmsmStats& stats);
