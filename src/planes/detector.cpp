@@ -155,8 +155,8 @@ void Detector::drop(std::size_t index) {
 // The patches of an accepted plane's blocks: its sheets (sheets.hpp), each cut into
 // connected pieces (gap 2 cells) and a wall's pieces joined across unseen gaps; largest
 // first. Neighbouring blocks of one sheet differ in their distance from the plane by at
-// most 3 standard deviations of the difference of two of the noise's: 3 √2 σ. Where
-// that exceeds the slab (2 ε) every block is in one sheet and the pass is skipped.
+// most sheet_step_; where that exceeds the slab (2 ε) every block is in one sheet and
+// the pass is skipped.
 SplitPatches Detector::splitSheets(const std::vector<std::uint32_t>& matching, const CandidatePlane& plane) const {
   const double step = sheet_step_;
   const Eigen::Vector3d normal = plane.normal.cast<double>();
@@ -187,8 +187,8 @@ SplitPatches Detector::splitSheets(const std::vector<std::uint32_t>& matching, c
     }
     split = std::move(sorted);
   }
-  // A wall's pieces are joined across unseen gaps along it, whichever sheets they are
-  // of; pieces one above the other (a sheet's step) are not along the wall.
+  // A wall's pieces are joined across unseen gaps along it, whichever sheet each came
+  // from, where their mean distances from the plane lie within the step (one face).
   const std::size_t count = split.patches.size();
   joinUnseenGaps(grid_, split.patches, normal, point, config_.epsilon, std::max<std::size_t>(config_.min_patch_blocks, 1),
                  config_.min_patch_area / (grid_.cellSize() * grid_.cellSize()), 0.3, step);
