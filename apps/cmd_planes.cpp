@@ -42,9 +42,12 @@ int runPlanes(const PlanesArguments& arguments, bool quiet) {
   // σ measured on a first pass's planes says what the build assumed.
   char assumed[80] = "";
   if (stats.prior_noise > 0.0) std::snprintf(assumed, sizeof assumed, " (measured; %.4f m assumed)", stats.prior_noise);
-  std::printf("  parameters: r %d cells, ε %.3f m, σ %.4f m%s, κ %g°, θ %g°, p_t %g, s_m %g m², "
+  // A plane may widen its ε up to max_epsilon where its own blocks spread more.
+  char widest[48] = "";
+  if (used.max_epsilon > used.epsilon) std::snprintf(widest, sizeof widest, " (a plane's up to %.3f m)", used.max_epsilon);
+  std::printf("  parameters: r %d cells, ε %.3f m%s, σ %.4f m%s, κ %g°, θ %g°, p_t %g, s_m %g m², "
               "Max_cp %d, seed %llu\n",
-              used.radius, used.epsilon, used.noise, assumed, used.kappa_deg, used.theta_deg, used.min_probability,
+              used.radius, used.epsilon, widest, used.noise, assumed, used.kappa_deg, used.theta_deg, used.min_probability,
               used.min_area, used.max_candidates, static_cast<unsigned long long>(used.seed));
   const ErmsmStageSeconds& stage = stats.stages;
   std::printf("  stages (s): noise %.3f, blocks %.3f, directions %.3f, index %.3f, search %.3f, patches %.3f, "

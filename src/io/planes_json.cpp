@@ -1,5 +1,7 @@
 #include "mlmap/io/planes_json.hpp"
 
+#include <algorithm>
+
 #include <charconv>
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -52,6 +54,7 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
                  {"bounds", {{"min", position(stats.min)}, {"max", position(stats.max)}}}};
   json["parameters"] = {{"radius_cells", config.radius},
                         {"epsilon", asFloat(config.epsilon)},
+                        {"max_epsilon", asFloat(std::max(config.epsilon, config.max_epsilon))},
                         {"kappa_deg", config.kappa_deg},
                         {"theta_deg", config.theta_deg},
                         {"min_probability", config.min_probability},

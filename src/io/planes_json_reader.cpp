@@ -123,6 +123,7 @@ ErmsmConfig readParameters(const Reader& reader, const json& parameters) {
   optional_number("max_refits", config.max_refits);
   optional_number("refit_gain", config.refit_gain);
   optional_number("noise", config.noise);
+  optional_number("max_epsilon", config.max_epsilon);
   optional_number("stack_gap", config.stack_gap);
   optional_number("ladder_gap", config.ladder_gap);
   optional_number("ladder_blocks", config.ladder_blocks);

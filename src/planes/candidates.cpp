@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "mlmap/planes/direction_vectors.hpp"
@@ -71,8 +72,10 @@ CandidateDraw drawCandidate(const CandidateSource& source, std::uint64_t seed, s
   return result;
 }
 
-void refitCandidate(const CandidateSource& source, Candidate& candidate) {
-  candidate.score = source.scorer.score(candidate.plane);
+namespace {
+
+// Algorithm 2's loop on a scored candidate.
+void refitScored(const CandidateSource& source, Candidate& candidate) {
   for (int iteration = 0; iteration < source.max_refits; ++iteration) {
     const PlaneScore& score = candidate.score;
     if (score.pca.weight < 3.0) return;
@@ -82,13 +85,49 @@ void refitCandidate(const CandidateSource& source, Candidate& candidate) {
     Eigen::Vector3f normal = solver.eigenvectors().col(0).cast<float>();
     if (!(normal.squaredNorm() > 0.5F)) return;
     if (normal.dot(candidate.plane.normal) < 0.0F) normal = -normal;
-    const CandidatePlane refitted{orientConsistently(normal), candidate.plane.point + mean.cast<float>()};
+    const CandidatePlane refitted{orientConsistently(normal), candidate.plane.point + mean.cast<float>(),
+                                  candidate.plane.epsilon};
     PlaneScore refitted_score = source.scorer.score(refitted);
     const double gain = refitted_score.score - score.score;
     if (gain < 0.0) return;
     candidate.plane = refitted;
     candidate.score = std::move(refitted_score);
     if (gain < source.refit_gain) return;
+  }
+}
+
+// The most the blocks a band holds may spread about its plane (RMS) for a fraction of
+// its half-width ε: blocks of a surface whose noise the band holds spread by σ_b ≤ ε / 3,
+// an RMS of 0.33 ε; a band of ±2.3 σ_b cuts 2 % of a normal spread and leaves 0.40 ε
+// (±1 σ_b 0.54 ε, blocks spread evenly over the band 0.58 ε). With 0.45 ε (a band of
+// ±2 σ_b), a level plane through tests/test_planes_noisy.cpp's heap of clutter kept
+// ε from the floor's noise (its blocks' means lie 2.2 cm RMS about it) and was a patch.
+constexpr double kMaxSpreadInBand = 0.4;
+
+// Whether the band ±ε cuts the spread of the blocks it holds: their RMS distance from
+// the plane beyond kMaxSpreadInBand ε.
+bool bandCutsSpread(const CandidatePlane& plane, const PlaneScore& score, float band) {
+  if (score.pca.weight < 3.0) return false;
+  const Eigen::Vector3d normal = plane.normal.cast<double>();
+  const Eigen::Vector3d mean = score.pca.mean();
+  // About the plane, not the blocks' mean: the spread the band holds.
+  const double offset = normal.dot(mean);
+  const double variance = normal.dot(score.pca.covariance() * normal) + offset * offset;
+  return std::sqrt(std::max(0.0, variance)) > kMaxSpreadInBand * band;
+}
+
+}  // namespace
+
+void refitCandidate(const CandidateSource& source, Candidate& candidate) {
+  candidate.score = source.scorer.score(candidate.plane);
+  refitScored(source, candidate);
+  // Widened in steps of 1.5: a band of ±1 σ_b widens to ±2.25 σ_b in two.
+  for (float band = source.scorer.bandOf(candidate.plane); band < source.max_epsilon;
+       band = source.scorer.bandOf(candidate.plane)) {
+    if (!bandCutsSpread(candidate.plane, candidate.score, band)) break;
+    candidate.plane.epsilon = std::min(1.5F * band, source.max_epsilon);
+    candidate.score = source.scorer.score(candidate.plane);
+    refitScored(source, candidate);
   }
 }
 

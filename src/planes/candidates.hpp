@@ -37,6 +37,7 @@ struct CandidateSource {
   float cos_theta = 1.0F;                       // of θ
   int max_refits = 5;                           // Algorithm 2's iterations at most
   double refit_gain = 1.0;                      // surface units
+  float max_epsilon = 0.0F;                     // m, the widest ε a candidate may widen to (0: the scorer's)
 };
 
 // Candidate number `number` of a run seeded with `seed`: its own generator, so the
@@ -47,7 +48,9 @@ CandidateDraw drawCandidate(const CandidateSource& source, std::uint64_t seed, s
 
 // Algorithm 2: scores the candidate, then refits its normal (and point) by PCA over
 // its matching blocks until the score gains less than the threshold; a refit that
-// loses is undone.
+// loses is undone. Beyond the paper, a candidate whose blocks spread so widely about it
+// that its band cuts their noise widens its ε (up to source.max_epsilon) and is refitted
+// again.
 void refitCandidate(const CandidateSource& source, Candidate& candidate);
 
 }  // namespace mlmap

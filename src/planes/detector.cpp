@@ -144,7 +144,7 @@ bool Detector::nearlyLevel(const CandidatePlane& plane) const {
 // blocks a chair or a lamp pulls off a table or ceiling do not count. Level planes only:
 // a vertical block sits at mid-height, its distance from a tilted plane says nothing.
 bool Detector::liesOnPlane(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const {
-  return medianDistance(grid_, strict, plane) <= config_.epsilon / 3.0;
+  return medianDistance(grid_, strict, plane) <= scorer_.bandOf(plane) / 3.0;
 }
 
 void Detector::drop(std::size_t index) {
@@ -159,10 +159,11 @@ void Detector::drop(std::size_t index) {
 // the pass is skipped.
 SplitPatches Detector::splitSheets(const std::vector<std::uint32_t>& matching, const CandidatePlane& plane) const {
   const double step = sheet_step_;
+  const double band = scorer_.bandOf(plane);
   const Eigen::Vector3d normal = plane.normal.cast<double>();
   const Eigen::Vector3d point = plane.point.cast<double>();
   SplitPatches split;
-  if (step >= 2.0 * config_.epsilon) {
+  if (step >= 2.0 * band) {
     split = splitWithOutlineRuns(grid_, matching, normal, point, 2, patch_threads_);
   } else {
     // Neighbours within 2 cells across, and in height within 2 cells or the stack gap
@@ -190,7 +191,7 @@ SplitPatches Detector::splitSheets(const std::vector<std::uint32_t>& matching, c
   // A wall's pieces are joined across unseen gaps along it, whichever sheet each came
   // from, where their mean distances from the plane lie within the step (one face).
   const std::size_t count = split.patches.size();
-  joinUnseenGaps(grid_, split.patches, normal, point, config_.epsilon, std::max<std::size_t>(config_.min_patch_blocks, 1),
+  joinUnseenGaps(grid_, split.patches, normal, point, band, std::max<std::size_t>(config_.min_patch_blocks, 1),
                  config_.min_patch_area / (grid_.cellSize() * grid_.cellSize()), 0.3, step);
   // A join leaves fewer patches: theirs are rasterised again for their outlines.
   if (split.patches.size() != count) split.outline_runs.assign(split.patches.size(), {});
@@ -221,7 +222,7 @@ bool Detector::accept(std::size_t index) {
     return false;
   }
   const std::vector<std::uint32_t> matching =
-      withEdges(grid_, directions_, scorer_, strict, accepted.plane, config_.epsilon, kappa);
+      withEdges(grid_, directions_, scorer_, strict, accepted.plane, scorer_.bandOf(accepted.plane), kappa);
   const double cell_area = grid_.cellSize() * grid_.cellSize();
   SplitPatches split = splitSheets(matching, accepted.plane);
   const double min_width =

@@ -51,7 +51,7 @@ class Detector {
   CandidateSource source() const {
     return CandidateSource{grid_, directions_, scorer_, seedable_, config_.radius,
                            static_cast<float>(std::cos(radians(config_.theta_deg))), config_.max_refits,
-                           config_.refit_gain};
+                           config_.refit_gain, static_cast<float>(config_.max_epsilon)};
   }
   std::optional<std::size_t> bestCandidate();
   double acceptanceProbability(const Candidate& leader) const;

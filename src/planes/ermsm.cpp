@@ -175,12 +175,20 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   // within 25 % of the first σ the first is kept. Either way the second pass cuts the
   // planes into sheets with it.
   again.noise = std::abs(std::log(*measured / config.noise)) <= std::log(1.25) ? config.noise : *measured;
-  // ε is widened by the measurement, never narrowed: a median over all blocks speaks for
-  // the surfaces seen best, and a sparse, far one (3DTK's ceiling at 5 cm cells; the 4 cm
-  // ceiling over a 1 cm floor of tests/test_planes_noisy.cpp) is lost with ε from the
-  // floor's noise. Narrowing it found plane_seg's first stair tread at 5 cm cells and
-  // lost room walls of PCL's room_scan1 and room_scan2.
-  if (again.epsilon <= 0.0) again.epsilon = defaultEpsilon(at_points, map.cellSize(), std::max(config.noise, again.noise));
+  // ε follows the measured σ, also where it is narrower than the assumed one's: from
+  // the 3 cm assumed for points from a file ε is 9 cm, more than half a stair's riser
+  // (plane_seg's ANYmal stairs: 16.5 cm), and every tread candidate refitted into a ramp
+  // through two treads. But a median over all blocks speaks for the surfaces seen best:
+  // a sparse, far one (3DTK's ceiling at 5 cm cells; the 4 cm ceiling over a 1 cm floor
+  // of tests/test_planes_noisy.cpp) is lost with ε from the floor's noise. So a candidate
+  // whose own blocks spread too widely for it widens its ε (refitCandidate), up to the
+  // ε of the larger σ, the one the first pass used.
+  if (again.epsilon <= 0.0) {
+    again.epsilon = defaultEpsilon(at_points, map.cellSize(), again.noise);
+    if (again.max_epsilon <= 0.0) {
+      again.max_epsilon = defaultEpsilon(at_points, map.cellSize(), std::max(config.noise, again.noise));
+    }
+  }
   const double first_pass_seconds = secondsSince(start);
   detection = detectOnce(map, again, block_noise, true);
   if (again.noise != config.noise) detection.stats.prior_noise = config.noise;

@@ -46,7 +46,7 @@ struct PlaneScorer::Query {
 
 PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
   PlaneScore result;
-  const Query query{plane.normal, -plane.normal.dot(plane.point), cos_kappa_, epsilon_};
+  const Query query{plane.normal, -plane.normal.dot(plane.point), cos_kappa_, bandOf(plane)};
   const Eigen::Vector3d origin = plane.point.cast<double>();
   auto whole = [&](const Node& node) {
     result.score += node.surface;
@@ -60,7 +60,7 @@ PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
         result.similar += surfaces_[k];
         if (slab == Slab::Outside) continue;
       }
-      if (std::abs(query.normal.dot(points_[k]) + query.offset) >= epsilon_) continue;
+      if (std::abs(query.normal.dot(points_[k]) + query.offset) >= query.epsilon) continue;
       result.score += surfaces_[k];
       result.pca.addBlock((points_[k] - plane.point).cast<double>(), half_depths_[k], surfaces_[k]);
     }
@@ -134,12 +134,12 @@ PlaneScore PlaneScorer::score(const CandidatePlane& plane) const {
 bool PlaneScorer::matches(std::uint32_t id, const CandidatePlane& plane) const {
   if (taken_[id] != 0 || directions_[id].squaredNorm() == 0.0F) return false;
   if (std::abs(directions_[id].dot(plane.normal)) < cos_kappa_) return false;
-  return std::abs(plane.normal.dot(grid_.blocks()[id].point - plane.point)) < epsilon_;
+  return std::abs(plane.normal.dot(grid_.blocks()[id].point - plane.point)) < bandOf(plane);
 }
 
 std::vector<std::uint32_t> PlaneScorer::matching(const CandidatePlane& plane) const {
   IdSet ids(grid_.size());
-  collect(Query{plane.normal, -plane.normal.dot(plane.point), cos_kappa_, epsilon_}, nullptr, ids);
+  collect(Query{plane.normal, -plane.normal.dot(plane.point), cos_kappa_, bandOf(plane)}, nullptr, ids);
   return ids.ascending();
 }
 
@@ -149,7 +149,7 @@ std::vector<std::uint32_t> PlaneScorer::near(const CandidatePlane& plane, float 
   IdSet ids(grid_.size());
   const Query query{plane.normal, -plane.normal.dot(plane.point), cos_cone - kSlack, reach + kSlack};
   // Tiles whose blocks all match the plane are left out: the caller has those.
-  const Query matching{plane.normal, query.offset, cos_kappa_, epsilon_};
+  const Query matching{plane.normal, query.offset, cos_kappa_, bandOf(plane)};
   collect(query, &matching, ids);
   for (std::size_t n = 0; n < undirected_.size(); ++n) {
     const std::uint32_t id = undirected_[n];

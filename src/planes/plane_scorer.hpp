@@ -27,6 +27,10 @@ namespace mlmap {
 struct CandidatePlane {
   Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();  // unit
   Eigen::Vector3f point = Eigen::Vector3f::Zero();    // m, a point on the plane
+  // m, the plane's ε: blocks closer than this match it; 0 = the scorer's (its narrowest).
+  // A candidate widens it up to ErmsmConfig::max_epsilon where its own blocks' spread
+  // says the band cuts their noise (refitCandidate).
+  float epsilon = 0.0F;
 };
 
 struct PlaneScore {
@@ -42,6 +46,8 @@ class PlaneScorer {
               double epsilon, double kappa_rad, int threads = 0);
 
   PlaneScore score(const CandidatePlane& plane) const;
+  // m, the plane's ε.
+  float bandOf(const CandidatePlane& plane) const { return plane.epsilon > 0.0F ? plane.epsilon : epsilon_; }
   // Ids of the untaken blocks matching the plane, ascending.
   std::vector<std::uint32_t> matching(const CandidatePlane& plane) const;
   bool matches(std::uint32_t id, const CandidatePlane& plane) const;

@@ -20,6 +20,10 @@ struct ErmsmConfig {
   // m, max block-plane distance ε; 0 = max(3 σ, min(cell size, 0.05)) (maps without point
   // moments: max(cell size, min(3 σ, 0.05)))
   double epsilon = 0.0;
+  // m: a plane whose blocks spread too widely for ε widens its own up to this (their
+  // noise, not the median surface's); 0 = ε. Set where σ was measured: ε from the
+  // measured σ, this from the σ assumed before.
+  double max_epsilon = 0.0;
   // m, σ of the points' range noise; 0 = measured: the median of the map's vertical
   // blocks' σ, then, where the blocks keep their points, about the planes found with it
   double noise = 0.0;
