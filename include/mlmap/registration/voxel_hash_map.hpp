@@ -50,8 +50,9 @@ class VoxelHashMap {
   // Points outside the OcTree's key range (±32768 voxels) are skipped.
   void addPoints(const std::vector<Point>& points);
   // One normal per voxel: PCA over the points of the voxels whose centres lie within
-  // config.radius of its centre, for the voxels whose neighbourhood gained points since the
-  // last call.
+  // config.radius of its centre (doubled up to config.max_radius where that is too sparse),
+  // for the voxels whose neighbourhood gained points since the last call and those whose
+  // last normal needed a wider neighbourhood.
   void estimateNormals(const NormalConfig& config = {});
 
   // The nearest point within `max_distance` of `query`, if any.
