@@ -69,14 +69,15 @@ struct Pair {
 };
 
 // `name`: where the scene's includes are looked up from.
-Pair simulatedPair(const std::string& json, const std::string& name = "scene.json") {
+Pair simulatedPair(const std::string& json, const std::string& name = "scene.json",
+                   const NormalConfig& normals = {}) {
   const mlmap::sim::Scene scene = mlmap::sim::parseScene(json, name);
   const auto scans = mlmap::sim::simulate(scene);
   Pair pair;
   std::vector<Point> world;
   for (std::size_t i = 0; i < scans[0].scan.size(); ++i) world.push_back(scans[0].scan.worldPoint(i));
   pair.target.addPoints(voxelDownSample(world, 0.05));
-  pair.target.estimateNormals();
+  pair.target.estimateNormals(normals);
   pair.source = voxelDownSample(scans[1].scan.points, 0.1);
   pair.true_pose = scans[1].true_pose;
   return pair;
@@ -230,4 +231,34 @@ TEST_CASE("alignVerified: a result slid along a corridor is not verified (the sl
   CAPTURE(error);
   CAPTURE(result.reason);
   CHECK((error < 0.02 || !result.verified));
+}
+
+TEST_CASE("alignVerified: a corridor fixed only by its far end walls is aligned along its axis") {
+  // 30 m of corridor, 2 cm noise; the sensor 14-16 m from either end wall, whose points
+  // (1 deg beams, 2 deg lines) lie 0.25-0.55 m apart: the only surfaces facing the axis.
+  // Normals over 0.2 m gave them none, so ICP saw a bare corridor, kept the start along its
+  // axis (0.3 m off) and called the result unconstrained; with the neighbourhood grown where
+  // it is sparse (NormalConfig::max_radius, as `mlmap register` estimates them) they pull.
+  const Pair corridor = simulatedPair(R"({
+    "scan_pattern": {"angular_step_deg": 0.5, "tilt_start_deg": -46, "tilt_end_deg": 46,
+                     "tilt_step_deg": 1.0, "range_sigma": 0.02, "mount_height": 1.2},
+    "poses": [{"x": 14.0, "y": 1.1}, {"x": 15.3, "y": 1.0, "yaw_deg": 4}],
+    "surfaces": [
+      {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [30, 2.2, 0]},
+      {"type": "rectangle", "class": "ceiling", "min": [0, 0, 2.8], "max": [30, 2.2, 2.8]},
+      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [30, 0, 2.8]},
+      {"type": "rectangle", "class": "wall", "min": [0, 2.2, 0], "max": [30, 2.2, 2.8]},
+      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 2.2, 2.8]},
+      {"type": "rectangle", "class": "wall", "min": [30, 0, 0], "max": [30, 2.2, 2.8]}
+    ]
+  })", "scene.json", NormalConfig{.max_radius = 0.8});
+  for (const double along : {0.3, -0.25}) {
+    CAPTURE(along);
+    const VerifiedIcp result = alignVerified(corridor.source, corridor.target,
+                                             startOff(corridor.true_pose, {along, 0.05, 0.0}, 3.0),
+                                             IcpConfig{.initial_max_distance = 0.5});
+    CHECK(result.verified);
+    CHECK(translationError(result.icp.pose, corridor.true_pose) < 0.02);
+    CHECK(rotationErrorDeg(result.icp.pose, corridor.true_pose) < 0.2);
+  }
 }

@@ -2,6 +2,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 
@@ -154,4 +155,45 @@ TEST_CASE("VoxelHashMap: normals after adding points match a map built at once")
     with_normal += a->normal.isZero() ? 0 : 1;
   }
   CHECK(with_normal > static_cast<int>(all.size()) * 8 / 10);
+}
+
+TEST_CASE("VoxelHashMap: a sparse plane gets normals from a grown neighbourhood, the same built at once or not") {
+  // A far wall sampled as a scanner 20 m away samples it (points 0.2 m apart along its rows,
+  // rows 0.4 m apart, 1 cm noise across): no 0.2 m neighbourhood holds six points off one row.
+  std::vector<Point> first, second;
+  std::uint32_t state = 12345;
+  const auto noise = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return (static_cast<double>(state >> 8) / 16777216.0 - 0.5) * 0.02;
+  };
+  for (double z = 0.0; z < 2.81; z += 0.4) {
+    for (double y = 0.0; y < 2.21; y += 0.2) (y < 1.1 ? first : second).emplace_back(20.0 + noise(), y, z);
+  }
+  std::vector<Point> all = first;
+  all.insert(all.end(), second.begin(), second.end());
+  VoxelHashMap fixed(0.1);
+  fixed.addPoints(all);
+  fixed.estimateNormals();
+  VoxelHashMap grown(0.1);
+  grown.addPoints(all);
+  grown.estimateNormals(mlmap::registration::NormalConfig{.max_radius = 0.8});
+  VoxelHashMap incremental(0.1);
+  incremental.addPoints(first);
+  incremental.estimateNormals(mlmap::registration::NormalConfig{.max_radius = 0.8});
+  incremental.addPoints(second);
+  incremental.estimateNormals(mlmap::registration::NormalConfig{.max_radius = 0.8});
+  int fixed_normals = 0, grown_facing = 0;
+  for (const Point& point : all) {
+    const auto a = fixed.nearest(point, 0.0);
+    const auto b = grown.nearest(point, 0.0);
+    const auto c = incremental.nearest(point, 0.0);
+    REQUIRE(a);
+    REQUIRE(b);
+    REQUIRE(c);
+    fixed_normals += a->normal.isZero() ? 0 : 1;
+    grown_facing += std::abs(b->normal.x()) > 0.99 ? 1 : 0;
+    CHECK((b->normal - c->normal).norm() < 1e-9);
+  }
+  CHECK(fixed_normals == 0);
+  CHECK(grown_facing > static_cast<int>(all.size()) * 8 / 10);
 }

@@ -95,7 +95,7 @@ CloudSurfaces cloudSurfaces(const std::vector<Point>& points, double voxel_size)
   // not of a sample of them, and each point's own voxel normal.
   VoxelHashMap cloud(voxel_size, std::numeric_limits<std::uint32_t>::max());
   cloud.addPoints(points);
-  cloud.estimateNormals(NormalConfig{.radius = 2.0 * voxel_size});
+  cloud.estimateNormals(NormalConfig{.radius = 2.0 * voxel_size, .max_radius = 8.0 * voxel_size});
   CloudSurfaces surfaces;
   surfaces.noise = cloud.surfaceNoise();
   surfaces.normals.resize(points.size(), Eigen::Vector3d::Zero());

@@ -20,10 +20,11 @@ bool inKeyRange(const VoxelKey& key) {
 }
 
 // The PCA normal of a neighbourhood from its moments (about any nearby point), or zero when it
-// is not planar.
+// is not planar; `sparse` says whether it was too sparse to tell (too few points, or one line).
 Normal planeNormal(std::size_t count, const Eigen::Vector3d& sum, const Eigen::Matrix3d& outer,
-                   const NormalConfig& config) {
-  if (count < config.min_neighbours) return Normal::Zero();
+                   const NormalConfig& config, bool& sparse) {
+  sparse = count < config.min_neighbours;
+  if (sparse) return Normal::Zero();
   const double n = static_cast<double>(count);
   const Eigen::Vector3d mean = sum / n;
   const Eigen::Matrix3d covariance = (outer - n * mean * mean.transpose()) / n;
@@ -35,9 +36,9 @@ Normal planeNormal(std::size_t count, const Eigen::Vector3d& sum, const Eigen::M
   const double total = eigenvalues.sum();
   // Planar: thin across (low curvature) and spread in two directions (not a line or a
   // strip of one scan line, whose normal can turn about the line).
-  if (total > 0.0 && eigenvalues[0] / total <= config.max_curvature && eigenvalues[1] > 0.05 * eigenvalues[2]) {
-    return solver.eigenvectors().col(0).normalized();
-  }
+  const bool thin = total > 0.0 && eigenvalues[0] / total <= config.max_curvature;
+  sparse = thin && !(eigenvalues[1] > 0.05 * eigenvalues[2]);
+  if (thin && !sparse) return solver.eigenvectors().col(0).normalized();
   return Normal::Zero();
 }
 
@@ -88,6 +89,7 @@ void VoxelHashMap::addPoints(const std::vector<Point>& points) {
       normals_.push_back(Normal::Zero());
       moments_.emplace_back();
       dirty_.push_back(0);
+      sparse_.push_back(0);
     }
     if (counts[voxel] >= max_points_per_voxel_) continue;
     ++counts[voxel];
@@ -191,8 +193,15 @@ std::vector<Point> VoxelHashMap::within(const Point& query, double radius) const
 void VoxelHashMap::estimateNormals(const NormalConfig& config) {
   stencil_ = sphereStencil(config.radius * inverse_size_);
   const std::vector<VoxelKey>& stencil = stencil_;
+  // The wider neighbourhoods a sparse voxel tries in turn (the radius doubling).
+  std::vector<std::vector<VoxelKey>> wider;
+  for (double radius = 2.0 * config.radius; radius <= config.max_radius * (1.0 + 1e-9); radius *= 2.0) {
+    wider.push_back(sphereStencil(radius * inverse_size_));
+  }
   // The voxels to (re)estimate: those that gained points and, when only some did, the
-  // neighbours whose stencil reaches them (their neighbourhood changed too).
+  // neighbours whose stencil reaches them (their neighbourhood changed too), and every voxel
+  // whose last normal needed a wider neighbourhood (few: the sparse far field; re-estimating
+  // them all is cheaper than marking through the widest stencil).
   const std::size_t voxels = table_.size();
   std::vector<std::uint32_t> todo;
   if (static_cast<std::size_t>(std::count(dirty_.begin(), dirty_.end(), 1)) == voxels) {
@@ -201,6 +210,7 @@ void VoxelHashMap::estimateNormals(const NormalConfig& config) {
   } else {
     std::vector<char> marked(voxels, 0);
     for (std::size_t v = 0; v < voxels; ++v) {
+      if (!wider.empty() && sparse_[v] != 0) marked[v] = 1;
       if (dirty_[v] == 0) continue;
       for (const VoxelKey& offset : stencil) {  // the stencil is symmetric
         const std::uint32_t index = table_.find(table_.key(static_cast<std::uint32_t>(v)) + offset);
@@ -211,15 +221,12 @@ void VoxelHashMap::estimateNormals(const NormalConfig& config) {
       if (marked[v] != 0) todo.push_back(static_cast<std::uint32_t>(v));
     }
   }
-  // Each voxel writes only its own normal, so the result does not depend on the thread count.
-  const long count = static_cast<long>(todo.size());
-#pragma omp parallel for schedule(dynamic, 256)
-  for (long n = 0; n < count; ++n) {
-    const std::uint32_t voxel = todo[static_cast<std::size_t>(n)];
+  // The PCA normal over one stencil about `voxel`'s centre; `sparse` as planeNormal's.
+  const auto normalOver = [&](std::uint32_t voxel, const std::vector<VoxelKey>& offsets, bool& sparse) {
     std::size_t points = 0;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();  // about this voxel's centre
     Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-    for (const VoxelKey& offset : stencil) {
+    for (const VoxelKey& offset : offsets) {
       const std::uint32_t index = table_.find(table_.key(voxel) + offset);
       if (index == VoxelTable::kMissing) continue;
       const Moments& moments = moments_[index];
@@ -231,7 +238,18 @@ void VoxelHashMap::estimateNormals(const NormalConfig& config) {
       outer += moments.outer + moments.sum * shift.transpose() + shift * moments.sum.transpose() +
                n_points * shift * shift.transpose();
     }
-    normals_[voxel] = planeNormal(points, sum, outer, config);
+    return planeNormal(points, sum, outer, config, sparse);
+  };
+  // Each voxel writes only its own normal, so the result does not depend on the thread count.
+  const long count = static_cast<long>(todo.size());
+#pragma omp parallel for schedule(dynamic, 256)
+  for (long n = 0; n < count; ++n) {
+    const std::uint32_t voxel = todo[static_cast<std::size_t>(n)];
+    bool sparse = false;
+    Normal normal = normalOver(voxel, stencil, sparse);
+    sparse_[voxel] = sparse ? 1 : 0;
+    for (std::size_t level = 0; sparse && level < wider.size(); ++level) normal = normalOver(voxel, wider[level], sparse);
+    normals_[voxel] = normal;
   }
   std::fill(dirty_.begin(), dirty_.end(), 0);
 }

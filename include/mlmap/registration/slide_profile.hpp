@@ -47,7 +47,8 @@ SlideProfile slideProfile(const std::vector<Point>& source, const std::vector<Ei
 
 // One normal per point of `points` (their own neighbourhood's PCA normal, zero where it is
 // not planar), and the cloud's surface noise (VoxelHashMap::surfaceNoise), from one voxel
-// hash of the points at `voxel_size` with normals over twice that radius.
+// hash of the points at `voxel_size` with normals over twice that radius, grown up to 8 voxels
+// where that is too sparse (a far end wall: NormalConfig::max_radius).
 struct CloudSurfaces {
   std::vector<Eigen::Vector3d> normals;
   double noise = 0.0;  // m

@@ -29,6 +29,15 @@ struct NormalConfig {
   double radius = 0.2;             // m, PCA over the voxels whose centres lie this close to the voxel's
   std::size_t min_neighbours = 6;  // fewer leaves the normal zero
   double max_curvature = 0.05;     // λ_min / (λ0 + λ1 + λ2) above this: not planar, zero normal
+  // m; where the neighbourhood within `radius` is too sparse for a plane (fewer than
+  // min_neighbours points, or points along one scan line only), the radius doubles up to this
+  // (like a k-nearest-neighbour normal, which reaches as far as the sampling needs). A far
+  // surface is sampled at range × the scan's angular step: the stress benchmark's long
+  // corridor's end wall, 20-26 m away at 1 deg between lines, holds points 0.35-0.45 m apart,
+  // and it is the only surface there facing the corridor's axis: 4 × the radius (two
+  // doublings) gives it normals (60 of 60 and 81 of 88 of its points in the map, none at
+  // 0.2 m; at 0.4 m 0 to 50). At most `radius`: no growth.
+  double max_radius = 0.0;
 };
 
 class VoxelHashMap {
@@ -41,8 +50,9 @@ class VoxelHashMap {
   // Points outside the OcTree's key range (±32768 voxels) are skipped.
   void addPoints(const std::vector<Point>& points);
   // One normal per voxel: PCA over the points of the voxels whose centres lie within
-  // config.radius of its centre, for the voxels whose neighbourhood gained points since the
-  // last call.
+  // config.radius of its centre (doubled up to config.max_radius where that is too sparse),
+  // for the voxels whose neighbourhood gained points since the last call and those whose
+  // last normal needed a wider neighbourhood.
   void estimateNormals(const NormalConfig& config = {});
 
   // The nearest point within `max_distance` of `query`, if any.
@@ -89,6 +99,7 @@ class VoxelHashMap {
   std::vector<Normal> normals_;          // shared by the voxel's points
   std::vector<Moments> moments_;
   std::vector<char> dirty_;              // gained points since the last estimateNormals()
+  std::vector<char> sparse_;             // its normal needed (or lacked) a wider neighbourhood
   std::vector<VoxelKey> stencil_;        // the neighbourhood of the last estimateNormals()
 };
 
