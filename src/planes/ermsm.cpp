@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <optional>
 
 #include "detector.hpp"
@@ -53,16 +54,102 @@ double defaultEpsilon(bool at_points, double cell_size, double noise) {
                    : std::max(cell_size, std::min(3.0 * noise, 0.05));
 }
 
-// One detection with σ and ε resolved (config.noise, config.epsilon > 0).
-// `block_noise`: the σ the blocks' variances were fused with (rangeNoise), which the rung
-// test compares them in. `sheets`: σ is known, planes are cut into sheets with it.
-PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config, double block_noise, bool sheets) {
+// What a detection needs before Algorithm 1: the eRMSM blocks and their direction
+// vectors, with the configurations they were made with. A second pass whose σ and ε
+// leave both unchanged runs on the first pass's.
+struct BlockField {
+  BlockGridConfig grid_config;
+  DirectionConfig direction_config;
+  std::optional<BlockGrid> grid;
+  DirectionField directions;
+};
+
+// A level rung is fused from a few points (under ten): its variance is a good part of
+// one point's σ², a table top's far below it; σ the build's, in which the blocks'
+// variances are, not the one measured on the planes.
+BlockGridConfig gridConfig(const ErmsmConfig& config, double block_noise) {
+  return BlockGridConfig{.stack_gap = config.stack_gap,
+                         .level_band = 5.0 * config.noise,
+                         .ladder_gap = config.ladder_gap,
+                         .ladder_blocks = config.ladder_blocks,
+                         .rung_variance = 0.1 * block_noise * block_noise};
+}
+
+DirectionConfig directionConfig(const ErmsmConfig& config) {
+  DirectionConfig direction_config;
+  direction_config.radius = config.radius;
+  // Two directions off their plane's normal by s per axis differ by more than θ in one
+  // pair of twenty when s = θ / (2.45 √2) (the difference's length is Rayleigh, 95 % below 2.45 √2 s).
+  direction_config.max_radius = config.max_radius > 0 ? config.max_radius : 2 * config.radius;
+  direction_config.max_tilt = radians(config.theta_deg) / (2.45 * std::sqrt(2.0));
+  direction_config.height_tolerance = static_cast<float>(config.epsilon);
+  direction_config.threads = config.threads;
+  return direction_config;
+}
+
+bool sameGridConfig(const BlockGridConfig& a, const BlockGridConfig& b) {
+  return a.stack_gap == b.stack_gap && a.level_band == b.level_band && a.ladder_gap == b.ladder_gap &&
+         a.ladder_blocks == b.ladder_blocks && a.rung_variance == b.rung_variance;
+}
+
+// Every field the direction vectors read but the thread count (same vectors at any).
+bool sameDirections(const DirectionConfig& a, const DirectionConfig& b) {
+  return a.radius == b.radius && a.height_tolerance == b.height_tolerance && a.max_radius == b.max_radius &&
+         a.max_tilt == b.max_tilt && a.corners == b.corners;
+}
+
+bool sameBlock(const PlaneBlock& a, const PlaneBlock& b) {
+  return a.point == b.point && a.offset_x == b.offset_x && a.offset_y == b.offset_y && a.top == b.top &&
+         a.bottom == b.bottom && a.surface == b.surface && a.vertical == b.vertical && a.cell.i == b.cell.i &&
+         a.cell.j == b.cell.j && a.map_first == b.map_first && a.map_count == b.map_count;
+}
+
+// Two grids of one map: the same blocks in the same order are the same grid (each block
+// names its cell, and the cells' numbering is the map's).
+bool sameBlocks(const BlockGrid& a, const BlockGrid& b) {
+  return std::equal(a.blocks().begin(), a.blocks().end(), b.blocks().begin(), b.blocks().end(), sameBlock);
+}
+
+// The blocks and directions for `config`, made anew or, where `earlier` (a first pass's)
+// already has them, taken from it: a second pass's σ moves the level band (the grid) only
+// where some stack's depth lies between the two bands, and ε (the directions' height
+// tolerance) only where it widens it. Either way the result is the one made anew.
+BlockField blockField(const MLMap& map, const ErmsmConfig& config, double block_noise, BlockField* earlier,
+                      ErmsmStats& stats, const std::function<double()>& stage) {
+  BlockField field;
+  field.grid_config = gridConfig(config, block_noise);
+  field.direction_config = directionConfig(config);
+  bool same_grid = false;
+  if (earlier != nullptr && sameGridConfig(earlier->grid_config, field.grid_config)) {
+    same_grid = true;
+  } else {
+    field.grid.emplace(map, field.grid_config);
+    ++stats.grids_built;
+    same_grid = earlier != nullptr && sameBlocks(*field.grid, *earlier->grid);
+  }
+  if (same_grid) {
+    field.grid = std::move(earlier->grid);
+    if (sameDirections(field.direction_config, earlier->direction_config)) field.directions = std::move(earlier->directions);
+  }
+  stats.stages.grid = stage();
+  if (field.directions.vectors.empty() && field.grid->size() > 0) {
+    field.directions = directionField(*field.grid, field.direction_config);
+    ++stats.direction_fields;
+  }
+  stats.stages.directions = stage();
+  return field;
+}
+
+// One detection with σ and ε resolved (config.noise, config.epsilon > 0), on `field`
+// (blockField). `sheets`: σ is known, planes are cut into sheets with it.
+PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double block_noise, bool sheets,
+                        BlockField* earlier, BlockField& field) {
   const auto start = Clock::now();
   auto stage_start = start;
   PlaneDetection detection;
   ErmsmStats& stats = detection.stats;
   // Seconds since the last call: the stage that just ended.
-  auto stage = [&stage_start] {
+  const std::function<double()> stage = [&stage_start] {
     const double seconds = secondsSince(stage_start);
     stage_start = Clock::now();
     return seconds;
@@ -72,25 +159,9 @@ PlaneDetection detectOnce(MLMap& map, const ErmsmConfig& input_config, double bl
   // The blocks' old labels need no clearing: the write-back at the end labels every
   // map block (each lies in one eRMSM block), 0 where no patch took it.
   stats.stages.noise = stage();
-  // A level rung is fused from a few points (under ten): its variance is a good part
-  // of one point's σ², a table top's far below it; σ the build's, in which the blocks'
-  // variances are, not the one measured on the planes.
-  const BlockGrid grid(map, BlockGridConfig{.stack_gap = config.stack_gap,
-                                            .level_band = 5.0 * config.noise,
-                                            .ladder_gap = config.ladder_gap,
-                                            .ladder_blocks = config.ladder_blocks,
-                                            .rung_variance = 0.1 * block_noise * block_noise});
-  stats.stages.grid = stage();
-  DirectionConfig direction_config;
-  direction_config.radius = config.radius;
-  // Two directions off their plane's normal by s per axis differ by more than θ in one
-  // pair of twenty when s = θ / (2.45 √2) (the difference's length is Rayleigh, 95 % below 2.45 √2 s).
-  direction_config.max_radius = config.max_radius > 0 ? config.max_radius : 2 * config.radius;
-  direction_config.max_tilt = radians(config.theta_deg) / (2.45 * std::sqrt(2.0));
-  direction_config.height_tolerance = static_cast<float>(config.epsilon);
-  direction_config.threads = config.threads;
-  const DirectionField directions = directionField(grid, direction_config);
-  stats.stages.directions = stage();
+  field = blockField(map, config, block_noise, earlier, stats, stage);
+  const BlockGrid& grid = *field.grid;
+  const DirectionField& directions = field.directions;
   stats.direction_seconds = secondsSince(start);
   stats.blocks = grid.size();
   stats.blocks_with_direction = static_cast<std::size_t>(
@@ -160,7 +231,8 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   // Sheets (sheets.hpp) only with σ known: given, or measured by the first pass. From
   // the σ assumed for points from a file (3 mm for a depth camera's PCD) the first pass
   // cut PCL's office1's walls and floor into their depth layers.
-  PlaneDetection detection = detectOnce(map, config, block_noise, !measure);
+  BlockField first;
+  PlaneDetection detection = detectOn(map, config, block_noise, !measure, nullptr, first);
   std::optional<double> measured = measure ? surfaceNoise(map, detection.planes) : std::nullopt;
   if (!measured) {
     chargeNoise(detection, estimate_seconds);
@@ -182,7 +254,11 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
   // lost room walls of PCL's room_scan1 and room_scan2.
   if (again.epsilon <= 0.0) again.epsilon = defaultEpsilon(at_points, map.cellSize(), std::max(config.noise, again.noise));
   const double first_pass_seconds = secondsSince(start);
-  detection = detectOnce(map, again, block_noise, true);
+  BlockField second;
+  const ErmsmStats first_stats = detection.stats;
+  detection = detectOn(map, again, block_noise, true, &first, second);
+  detection.stats.grids_built += first_stats.grids_built;
+  detection.stats.direction_fields += first_stats.direction_fields;
   if (again.noise != config.noise) detection.stats.prior_noise = config.noise;
   detection.stats.passes = 2;
   chargeNoise(detection, first_pass_seconds);

@@ -86,6 +86,10 @@ struct ErmsmStats {
   // 0 where one pass sufficed
   double prior_noise = 0.0;
   int passes = 1;                   // detections run: 2 where σ was measured on a first pass's planes
+  // eRMSM block grids and direction fields made, over all passes: a second pass makes
+  // neither where its σ and ε leave them as the first pass's (detectPlanes)
+  int grids_built = 0;
+  int direction_fields = 0;
   double direction_seconds = 0.0;   // noise estimate, eRMSM blocks and direction vectors
   double detection_seconds = 0.0;   // Algorithm 1 with refits, patch split, merges, classes, labels
   ErmsmStageSeconds stages;         // both, split further

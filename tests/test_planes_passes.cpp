@@ -1,0 +1,75 @@
+// detectPlanes' second pass (σ measured on the first pass's planes) reuses the first
+// pass's eRMSM blocks and direction vectors where its σ and ε leave them unchanged, and
+// finds exactly the planes a single detection with that σ and ε finds.
+#include <doctest/doctest.h>
+
+#include "mlmap/planes/ermsm.hpp"
+#include "plane_scenes.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+// A 4 × 3 m room at 5 cm cells: floor, two walls, a table; points scatter by `noise`,
+// the build assumed `assumed` for them.
+test::PlaneSceneBuilder room(double noise, double assumed, unsigned seed) {
+  test::PlaneSceneBuilder scene(0.05, noise, seed);
+  scene.withNoise(noise, assumed * assumed)
+      .rectangle({0.0, 0.0, 0.0}, {4.0, 0.0, 0.0}, {0.0, 3.0, 0.0}, 0.01)
+      .wallX(0.0, 0.0, 3.0, 0.0, 2.4)
+      .wallY(0.0, 0.0, 4.0, 0.0, 2.4)
+      .rectangle({1.0, 1.0, 0.75}, {1.2, 0.0, 0.0}, {0.0, 0.8, 0.0}, 0.01);
+  return scene;
+}
+
+// The same patches, bit for bit (the map's labels follow from them).
+void checkSamePlanes(const PlaneDetection& a, const PlaneDetection& b) {
+  REQUIRE(a.planes.size() == b.planes.size());
+  for (std::size_t k = 0; k < a.planes.size(); ++k) {
+    CAPTURE(k);
+    CHECK(a.planes[k].normal == b.planes[k].normal);
+    CHECK(a.planes[k].offset == b.planes[k].offset);
+    CHECK(a.planes[k].block_count == b.planes[k].block_count);
+    CHECK(a.planes[k].area == b.planes[k].area);
+    CHECK(a.planes[k].outline == b.planes[k].outline);
+  }
+  CHECK(a.stats.labelled_blocks == b.stats.labelled_blocks);
+}
+
+}  // namespace
+
+TEST_CASE("Planes, second pass: σ kept, the first pass's blocks and directions are reused") {
+  // Points scatter as the build assumed: the measured σ stays within 25 % of it.
+  test::PlaneSceneBuilder scene = room(0.01, 0.01, 1);
+  const PlaneDetection measured = detectPlanes(scene.map());
+  CAPTURE(measured.config.noise);
+  REQUIRE(measured.stats.passes == 2);
+  REQUIRE(measured.stats.prior_noise == 0.0);
+  CHECK(measured.stats.grids_built == 1);
+  CHECK(measured.stats.direction_fields == 1);
+  CHECK(measured.planes.size() >= 4);
+  // One pass told that σ and ε: the same planes.
+  ErmsmConfig given;
+  given.noise = measured.config.noise;
+  given.epsilon = measured.config.epsilon;
+  const PlaneDetection once = detectPlanes(scene.map(), given);
+  CHECK(once.stats.passes == 1);
+  checkSamePlanes(measured, once);
+}
+
+TEST_CASE("Planes, second pass: σ moved, what depends on it is made again") {
+  // Points scatter by 1.5 cm where the build assumed 3 mm (PCL's office1): σ moves, the
+  // level band (5 σ) with it, and ε (3 σ) beyond the cell's 5 cm.
+  test::PlaneSceneBuilder scene = room(0.025, 0.003, 2);
+  const PlaneDetection measured = detectPlanes(scene.map());
+  CAPTURE(measured.config.noise);
+  REQUIRE(measured.stats.passes == 2);
+  REQUIRE(measured.stats.prior_noise > 0.0);
+  CHECK(measured.config.epsilon > 0.05);
+  CHECK(measured.stats.direction_fields == 2);
+  ErmsmConfig given;
+  given.noise = measured.config.noise;
+  given.epsilon = measured.config.epsilon;
+  const PlaneDetection once = detectPlanes(scene.map(), given);
+  checkSamePlanes(measured, once);
+}
