@@ -60,13 +60,30 @@ TEST_CASE("Planes, second pass: σ kept, the first pass's blocks and directions 
 TEST_CASE("Planes, second pass: σ moved, what depends on it is made again") {
   // Points scatter by 1.5 cm where the build assumed 3 mm (PCL's office1): σ moves, the
   // level band (5 σ) with it, and ε (3 σ) beyond the cell's 5 cm.
-  test::PlaneSceneBuilder scene = room(0.025, 0.003, 2);
+  test::PlaneSceneBuilder scene = room(0.02, 0.003, 2);
   const PlaneDetection measured = detectPlanes(scene.map());
   CAPTURE(measured.config.noise);
   REQUIRE(measured.stats.passes == 2);
   REQUIRE(measured.stats.prior_noise > 0.0);
   CHECK(measured.config.epsilon > 0.05);
   CHECK(measured.stats.direction_fields == 2);
+  ErmsmConfig given;
+  given.noise = measured.config.noise;
+  given.epsilon = measured.config.epsilon;
+  const PlaneDetection once = detectPlanes(scene.map(), given);
+  checkSamePlanes(measured, once);
+}
+
+TEST_CASE("Planes, second pass: where the short first search labels too few blocks, the whole one measures σ") {
+  // 2.5 cm of scatter where 3 mm were assumed: the first 100 idle candidates find too
+  // little to measure σ on, the whole search of 300 does.
+  test::PlaneSceneBuilder scene = room(0.025, 0.003, 2);
+  const PlaneDetection measured = detectPlanes(scene.map());
+  CAPTURE(measured.config.noise);
+  REQUIRE(measured.stats.passes == 3);
+  CHECK(measured.stats.prior_noise > 0.0);
+  CHECK(measured.config.noise > 0.015);
+  CHECK(measured.stats.grids_built <= 2);
   ErmsmConfig given;
   given.noise = measured.config.noise;
   given.epsilon = measured.config.epsilon;

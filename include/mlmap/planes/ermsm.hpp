@@ -85,7 +85,9 @@ struct ErmsmStats {
   // m: where σ was measured on a first pass's planes (see detectPlanes), that pass's σ;
   // 0 where one pass sufficed
   double prior_noise = 0.0;
-  int passes = 1;                   // detections run: 2 where σ was measured on a first pass's planes
+  // detections run: 2 where σ was measured on a first pass's planes (3 where that pass's
+  // shorter search left too few blocks to measure it on, and the whole search ran)
+  int passes = 1;
   // eRMSM block grids and direction fields made, over all passes: a second pass makes
   // neither where its σ and ε leave them as the first pass's (detectPlanes)
   int grids_built = 0;
