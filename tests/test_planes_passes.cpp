@@ -3,6 +3,10 @@
 // finds exactly the planes a single detection with that σ and ε finds.
 #include <doctest/doctest.h>
 
+#include <cmath>
+
+#include "mlmap/planes/block_grid.hpp"
+#include "mlmap/planes/direction_vectors.hpp"
 #include "mlmap/planes/ermsm.hpp"
 #include "plane_scenes.hpp"
 
@@ -89,4 +93,37 @@ TEST_CASE("Planes, second pass: where the short first search labels too few bloc
   given.epsilon = measured.config.epsilon;
   const PlaneDetection once = detectPlanes(scene.map(), given);
   checkSamePlanes(measured, once);
+}
+
+TEST_CASE("Planes, second pass: directions updated where another level band changed some blocks are the whole field's") {
+  // A noisy 1 m² board in a quiet room: its cells' blocks, 5-10 cm deep, are level under
+  // a 10 cm band and vertical under a 5 cm one; the rest of the map is the same in both.
+  test::PlaneSceneBuilder scene = room(0.005, 0.005, 3);
+  scene.withNoise(0.03, 0.0004).rectangle({2.5, 0.5, 0.4}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.02);
+  const BlockGrid narrow(scene.map(), BlockGridConfig{.stack_gap = 0.06, .level_band = 0.05});
+  const BlockGrid wide(scene.map(), BlockGridConfig{.stack_gap = 0.06, .level_band = 0.10});
+  REQUIRE(narrow.size() == wide.size());
+  std::vector<std::uint32_t> changed;
+  for (std::uint32_t id = 0; id < narrow.size(); ++id) {
+    if (narrow.blocks()[id].vertical != wide.blocks()[id].vertical || narrow.blocks()[id].point != wide.blocks()[id].point) {
+      changed.push_back(id);
+    }
+  }
+  CAPTURE(changed.size());
+  CHECK(!changed.empty());
+  CHECK(changed.size() < narrow.size() / 20);  // so only the board's surroundings are computed again
+  DirectionConfig config;
+  config.radius = 2;
+  config.max_radius = 4;
+  config.max_tilt = 0.05;
+  config.height_tolerance = 0.06F;
+  const DirectionField whole = directionField(wide, config);
+  const DirectionField updated = updatedDirectionField(wide, config, directionField(narrow, config), changed);
+  REQUIRE(updated.vectors.size() == whole.vectors.size());
+  std::size_t differing = 0;
+  for (std::size_t id = 0; id < whole.vectors.size(); ++id) {
+    const bool same_tilt = updated.tilts[id] == whole.tilts[id] || (std::isnan(updated.tilts[id]) && std::isnan(whole.tilts[id]));
+    if (updated.vectors[id] != whole.vectors[id] || !same_tilt) ++differing;
+  }
+  CHECK(differing == 0);
 }

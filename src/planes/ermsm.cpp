@@ -104,10 +104,19 @@ bool sameBlock(const PlaneBlock& a, const PlaneBlock& b) {
          a.cell.j == b.cell.j && a.map_first == b.map_first && a.map_count == b.map_count;
 }
 
-// Two grids of one map: the same blocks in the same order are the same grid (each block
-// names its cell, and the cells' numbering is the map's).
-bool sameBlocks(const BlockGrid& a, const BlockGrid& b) {
-  return std::equal(a.blocks().begin(), a.blocks().end(), b.blocks().begin(), b.blocks().end(), sameBlock);
+// Two grids of one map with the same blocks of the same cells (another level band
+// changes only their depth class and height): the ids whose blocks differ; nullopt where
+// the grids hold other blocks.
+std::optional<std::vector<std::uint32_t>> changedBlocks(const BlockGrid& a, const BlockGrid& b) {
+  if (a.size() != b.size()) return std::nullopt;
+  std::vector<std::uint32_t> changed;
+  for (std::uint32_t id = 0; id < a.size(); ++id) {
+    const PlaneBlock& x = a.blocks()[id];
+    const PlaneBlock& y = b.blocks()[id];
+    if (!(x.cell == y.cell) || x.map_first != y.map_first || x.map_count != y.map_count) return std::nullopt;
+    if (!sameBlock(x, y)) changed.push_back(id);
+  }
+  return changed;
 }
 
 // The blocks and directions for `config`, made anew or, where `earlier` (a first pass's)
@@ -119,19 +128,26 @@ BlockField blockField(const MLMap& map, const ErmsmConfig& config, double block_
   BlockField field;
   field.grid_config = gridConfig(config, block_noise);
   field.direction_config = directionConfig(config);
-  bool same_grid = false;
+  // The blocks that differ from the earlier grid's (all, without one).
+  std::optional<std::vector<std::uint32_t>> changed;
   if (earlier != nullptr && sameGridConfig(earlier->grid_config, field.grid_config)) {
-    same_grid = true;
+    changed.emplace();
   } else {
     field.grid.emplace(map, field.grid_config);
     ++stats.grids_built;
-    same_grid = earlier != nullptr && sameBlocks(*field.grid, *earlier->grid);
+    if (earlier != nullptr) changed = changedBlocks(*field.grid, *earlier->grid);
   }
-  if (same_grid) {
-    field.grid = std::move(earlier->grid);
-    if (sameDirections(field.direction_config, earlier->direction_config)) field.directions = std::move(earlier->directions);
-  }
+  if (changed && changed->empty()) field.grid = std::move(earlier->grid);
   stats.stages.grid = stage();
+  if (changed && sameDirections(field.direction_config, earlier->direction_config)) {
+    if (changed->empty()) {
+      field.directions = std::move(earlier->directions);
+    } else {
+      // The blocks whose windows hold a changed block, again.
+      field.directions = updatedDirectionField(*field.grid, field.direction_config, std::move(earlier->directions), *changed);
+      ++stats.direction_updates;
+    }
+  }
   if (field.directions.vectors.empty() && field.grid->size() > 0) {
     field.directions = directionField(*field.grid, field.direction_config);
     ++stats.direction_fields;
@@ -260,6 +276,7 @@ PlaneDetection detectPlanes(MLMap& map, const ErmsmConfig& input_config) {
     first = std::move(next);
     detection.stats.grids_built += before.grids_built;
     detection.stats.direction_fields += before.direction_fields;
+    detection.stats.direction_updates += before.direction_updates;
     detection.stats.passes = before.passes + 1;
     chargeNoise(detection, before_seconds);
   };

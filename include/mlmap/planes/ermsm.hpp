@@ -92,6 +92,9 @@ struct ErmsmStats {
   // neither where its σ and ε leave them as the first pass's (detectPlanes)
   int grids_built = 0;
   int direction_fields = 0;
+  // direction fields brought up to date from an earlier pass's where σ changed some
+  // blocks only (updatedDirectionField: the blocks near them, or all where those are most)
+  int direction_updates = 0;
   double direction_seconds = 0.0;   // noise estimate, eRMSM blocks and direction vectors
   double detection_seconds = 0.0;   // Algorithm 1 with refits, patch split, merges, classes, labels
   ErmsmStageSeconds stages;         // both, split further
