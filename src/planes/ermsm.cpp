@@ -241,8 +241,10 @@ ErmsmConfig measuringPass(const ErmsmConfig& config) {
 // (surface_noise.hpp), about the noise the planes must tolerate, surface waviness and
 // registration included. On the real scans of bench/real_data.py at 5 cm cells, against
 // 3 cm assumed: 3DTK 2.3 cm, OctoMap's fr079 0.9, Bobkov's room 1.9, PCL's office1 1.2
-// and room scans 1.2-1.3, plane_seg's stairs 1.0 and 0.8. The planes are detected again
-// with it, σ moved only where it lies beyond 25 % of the first: on those eight scans the
+// and room scans 1.2-1.3, plane_seg's stairs 1.0 and 0.8 (that first pass a shorter
+// search: measuringPass). The planes are detected again with it (on the first pass's
+// blocks and direction vectors where it leaves them as they are: blockField), σ moved
+// only where it lies beyond 25 % of the first: on those eight scans the
 // estimate itself moves by 16-53 % (median 28 %) between 5 and 10 cm cells, and its
 // median over 100 blocks spreads -11..-29 % to +15..+41 % (95 % of 400 bootstrap draws;
 // surface_noise.hpp), so a smaller difference is not a measured one.
