@@ -14,8 +14,9 @@ map in turn (so a busy spell of the shared machine falls on all maps alike); --r
 Per map: the best and the median seconds (the planes JSON's total_s: everything after reading
 the map), microseconds per map block (best / median), the median against the lab's at the same
 cell size, the candidate planes drawn (by the last pass; each is scored and refitted up to 5 times), the median of every stage in microseconds per block (`first` is the noise stage: where
-the planes measure σ and it moves ε or the level band, the whole first detection, then detected
-again: `passes` 2), and with --peers CGAL's normals + detection on the scene's points (best of
+the blocks keep their points, a first detection that measures σ (its search stopped after 100
+idle candidates), then the planes detected again with it on the same blocks and direction
+vectors where σ leaves them as they are: `passes` 2), and with --peers CGAL's normals + detection on the scene's points (best of
 --repeat; the points are the ones mlmap maps, so CGAL's time per point stands beside mlmap's).
 Scenes without data are skipped with a message. Writes OUT/planes_speed.md too.
 """

@@ -185,7 +185,7 @@ PlaneDetection parsePlanesJson(std::string_view text, const std::string& name) {
   stats.blocks_with_direction =
       static_cast<std::size_t>(reader.integer(run, "detection", "blocks_with_direction", 0, kCountMax));
   // Files written before the count was kept ran one pass or did not say.
-  if (run.contains("passes")) stats.passes = static_cast<int>(reader.integer(run, "detection", "passes", 1, 2));
+  if (run.contains("passes")) stats.passes = static_cast<int>(reader.integer(run, "detection", "passes", 1, 3));
   const json& parameters = reader.member(document, "top level", "parameters");
   if (parameters.contains("assumed_noise")) stats.prior_noise = reader.number(parameters, "parameters", "assumed_noise");
   const json& timings = reader.member(document, "top level", "timings");

@@ -217,6 +217,31 @@ Eigen::Vector3f orientConsistently(const Eigen::Vector3f& normal) {
 
 namespace {
 
+// One uncertain level block's window, wider a cell at a time from `best` (its window
+// of r cells'): the most certain direction it reaches. `columns`, `window`: scratch of
+// 2 max_radius + 1 columns.
+Direction widened(const BlockGrid& grid, const DirectionConfig& config, double min_spread, const PlaneBlock& block,
+                  Direction best, std::vector<Column>& columns, std::vector<const Column*>& window) {
+  for (int radius = config.radius + 1; radius <= config.max_radius; ++radius) {
+    for (int c = 0; c <= 2 * radius; ++c) {
+      fillColumn(grid, columns[static_cast<std::size_t>(c)], block.cell.i, radius, std::int64_t{block.cell.j} - radius + c);
+      window[static_cast<std::size_t>(c)] = &columns[static_cast<std::size_t>(c)];
+    }
+    const Direction wider =
+        directionOf(block, window.data(), radius, config.height_tolerance, config.corners, grid.cellSize(), min_spread);
+    if (wider.tilt < best.tilt) best = wider;
+    if (best.tilt <= config.max_tilt) break;
+  }
+  return best;
+}
+
+bool widens(const DirectionConfig& config) { return config.max_radius > config.radius && config.max_tilt > 0.0; }
+
+// Whether a block's window of r cells leaves its direction uncertain enough to widen.
+bool uncertain(const DirectionConfig& config, const PlaneBlock& block, float tilt) {
+  return tilt > config.max_tilt && std::isfinite(tilt) && !block.vertical;
+}
+
 // The uncertain level blocks' windows, a cell wider at a time: each block keeps the most
 // certain direction it reaches, and stops once within max_tilt. Few blocks on most
 // maps, so each builds its own window rather than sliding one along the rows. Only
@@ -229,9 +254,8 @@ void widenUncertain(const BlockGrid& grid, const DirectionConfig& config, double
   std::vector<float>& tilts = field.tilts;
   std::vector<std::uint32_t> ids;
   for (std::uint32_t id = 0; id < tilts.size(); ++id) {
-    if (tilts[id] > config.max_tilt && std::isfinite(tilts[id]) && !grid.blocks()[id].vertical) ids.push_back(id);
+    if (uncertain(config, grid.blocks()[id], tilts[id])) ids.push_back(id);
   }
-  const double cell = grid.cellSize();
   const auto count = static_cast<std::int64_t>(ids.size());
 #ifdef _OPENMP
   const int threads = config.threads > 0 ? config.threads : omp_get_max_threads();
@@ -243,18 +267,9 @@ void widenUncertain(const BlockGrid& grid, const DirectionConfig& config, double
 #pragma omp for schedule(dynamic, 64)
     for (std::int64_t k = 0; k < count; ++k) {
       const std::uint32_t id = ids[static_cast<std::size_t>(k)];
-      const PlaneBlock& block = grid.blocks()[id];
-      Direction best{directions[id], tilts[id]};
-      for (int radius = config.radius + 1; radius <= config.max_radius; ++radius) {
-        for (int c = 0; c <= 2 * radius; ++c) {
-          fillColumn(grid, columns[static_cast<std::size_t>(c)], block.cell.i, radius, std::int64_t{block.cell.j} - radius + c);
-          window[static_cast<std::size_t>(c)] = &columns[static_cast<std::size_t>(c)];
-        }
-        const Direction wider = directionOf(block, window.data(), radius, config.height_tolerance, config.corners, cell, min_spread);
-        if (wider.tilt < best.tilt) best = wider;
-        if (best.tilt <= config.max_tilt) break;
-      }
       // Still uncertain at the widest: the most certain window's.
+      const Direction best =
+          widened(grid, config, min_spread, grid.blocks()[id], Direction{directions[id], tilts[id]}, columns, window);
       directions[id] = best.vector;
       tilts[id] = static_cast<float>(best.tilt);
     }
@@ -276,7 +291,7 @@ DirectionField directionField(const BlockGrid& grid, const DirectionConfig& conf
   std::vector<float>& tilts = field.tilts;
   directions.resize(grid.size());
   tilts.resize(grid.size());
-  const bool widen = config.max_radius > config.radius && config.max_tilt > 0.0;
+  const bool widen = widens(config);
   const double cell = grid.cellSize();
   const double min_spread = 0.1 * cell * cell;
   const int radius = std::max(0, config.radius);
@@ -324,6 +339,68 @@ DirectionField directionField(const BlockGrid& grid, const DirectionConfig& conf
   }
   if (widen) widenUncertain(grid, config, min_spread, field);
   return field;
+}
+
+DirectionField updatedDirectionField(const BlockGrid& grid, const DirectionConfig& config, DirectionField earlier,
+                                     const std::vector<std::uint32_t>& changed) {
+  const bool widen = widens(config);
+  const int radius = std::max(0, config.radius);
+  // A block's direction reads the blocks of its window only: of r cells, and of up to
+  // max_radius where it widens.
+  const int reach = widen ? std::max(radius, config.max_radius) : radius;
+  std::vector<std::uint8_t> stale(grid.size(), 0);
+  std::size_t stale_count = 0;
+  for (const std::uint32_t id : changed) {
+    grid.forEachNeighbour(grid.blocks()[id].cell, reach, [&](std::uint32_t other) {
+      stale_count += stale[other] == 0 ? 1 : 0;
+      stale[other] = 1;
+    });
+  }
+  // Most of the map: the sliding windows of a whole pass are cheaper than a window each.
+  if (2 * stale_count > grid.size() || earlier.vectors.size() != grid.size()) return directionField(grid, config);
+  // The stale blocks a cell at a time (ids ascend cell by cell): each cell's window once.
+  std::vector<std::uint32_t> cell_starts;
+  for (std::uint32_t id = 0; id < grid.size(); ++id) {
+    if (stale[id] == 0) continue;
+    if (cell_starts.empty() || !(grid.blocks()[cell_starts.back()].cell == grid.blocks()[id].cell)) cell_starts.push_back(id);
+  }
+  const double cell = grid.cellSize();
+  const double min_spread = 0.1 * cell * cell;
+  const auto cells = static_cast<std::int64_t>(cell_starts.size());
+  const auto& blocks = grid.blocks();
+#ifdef _OPENMP
+  const int threads = config.threads > 0 ? config.threads : omp_get_max_threads();
+#endif
+#pragma omp parallel num_threads(threads)
+  {
+    std::vector<Column> columns(static_cast<std::size_t>(2 * std::max(radius, config.max_radius) + 1));
+    std::vector<const Column*> window(columns.size());
+#pragma omp for schedule(dynamic, 16)
+    for (std::int64_t n = 0; n < cells; ++n) {
+      const std::uint32_t begin = cell_starts[static_cast<std::size_t>(n)];
+      const CellIndex here = blocks[begin].cell;
+      for (int c = 0; c <= 2 * radius; ++c) {
+        fillColumn(grid, columns[static_cast<std::size_t>(c)], here.i, radius, std::int64_t{here.j} - radius + c);
+        window[static_cast<std::size_t>(c)] = &columns[static_cast<std::size_t>(c)];
+      }
+      std::vector<std::uint32_t> uncertain_ids;
+      for (std::uint32_t id = begin; id < grid.size() && blocks[id].cell == here; ++id) {
+        const Direction direction =
+            directionOf(blocks[id], window.data(), radius, config.height_tolerance, config.corners, cell, min_spread);
+        earlier.vectors[id] = direction.vector;
+        earlier.tilts[id] = static_cast<float>(direction.tilt);
+        if (widen && uncertain(config, blocks[id], earlier.tilts[id])) uncertain_ids.push_back(id);
+      }
+      // After the cell's r-cell windows: widening refills the scratch columns.
+      for (const std::uint32_t id : uncertain_ids) {
+        const Direction best =
+            widened(grid, config, min_spread, blocks[id], Direction{earlier.vectors[id], earlier.tilts[id]}, columns, window);
+        earlier.vectors[id] = best.vector;
+        earlier.tilts[id] = static_cast<float>(best.tilt);
+      }
+    }
+  }
+  return earlier;
 }
 
 }  // namespace mlmap

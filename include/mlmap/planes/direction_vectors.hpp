@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <vector>
 
 #include "mlmap/planes/block_grid.hpp"
@@ -45,6 +46,14 @@ struct DirectionField {
 };
 
 DirectionField directionField(const BlockGrid& grid, const DirectionConfig& config);
+
+// directionField(grid, config) from `earlier`, the field (same config) of another grid
+// of the same map whose blocks differ from `grid`'s only at the ids `changed` (the same
+// blocks of the same cells, some of them other in depth class or height: another level
+// band). Only the blocks whose windows, up to max_radius, hold a changed block are
+// computed again; where those are most of the map, all are.
+DirectionField updatedDirectionField(const BlockGrid& grid, const DirectionConfig& config, DirectionField earlier,
+                                     const std::vector<std::uint32_t>& changed);
 
 // The vectors alone.
 std::vector<Eigen::Vector3f> directionVectors(const BlockGrid& grid, const DirectionConfig& config);

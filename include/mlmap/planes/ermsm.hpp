@@ -89,7 +89,16 @@ struct ErmsmStats {
   // m: where σ was measured on a first pass's planes (see detectPlanes), that pass's σ;
   // 0 where one pass sufficed
   double prior_noise = 0.0;
-  int passes = 1;                   // detections run: 2 where σ was measured on a first pass's planes
+  // detections run: 2 where σ was measured on a first pass's planes (3 where that pass's
+  // shorter search left too few blocks to measure it on, and the whole search ran)
+  int passes = 1;
+  // eRMSM block grids and direction fields made, over all passes: a second pass makes
+  // neither where its σ and ε leave them as the first pass's (detectPlanes)
+  int grids_built = 0;
+  int direction_fields = 0;
+  // direction fields brought up to date from an earlier pass's where σ changed some
+  // blocks only (updatedDirectionField: the blocks near them, or all where those are most)
+  int direction_updates = 0;
   double direction_seconds = 0.0;   // noise estimate, eRMSM blocks and direction vectors
   double detection_seconds = 0.0;   // Algorithm 1 with refits, patch split, merges, classes, labels
   ErmsmStageSeconds stages;         // both, split further
