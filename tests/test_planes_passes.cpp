@@ -40,6 +40,16 @@ void checkSamePlanes(const PlaneDetection& a, const PlaneDetection& b) {
   CHECK(a.stats.labelled_blocks == b.stats.labelled_blocks);
 }
 
+// One detection told the σ and ε a measured detection ended with: it must find the same.
+void checkSameAsOnePass(MLMap& map, const PlaneDetection& measured) {
+  ErmsmConfig given;
+  given.noise = measured.config.noise;
+  given.epsilon = measured.config.epsilon;
+  const PlaneDetection once = detectPlanes(map, given);
+  CHECK(once.stats.passes == 1);
+  checkSamePlanes(measured, once);
+}
+
 }  // namespace
 
 TEST_CASE("Planes, second pass: σ kept, the first pass's blocks and directions are reused") {
@@ -52,13 +62,7 @@ TEST_CASE("Planes, second pass: σ kept, the first pass's blocks and directions 
   CHECK(measured.stats.grids_built == 1);
   CHECK(measured.stats.direction_fields == 1);
   CHECK(measured.planes.size() >= 4);
-  // One pass told that σ and ε: the same planes.
-  ErmsmConfig given;
-  given.noise = measured.config.noise;
-  given.epsilon = measured.config.epsilon;
-  const PlaneDetection once = detectPlanes(scene.map(), given);
-  CHECK(once.stats.passes == 1);
-  checkSamePlanes(measured, once);
+  checkSameAsOnePass(scene.map(), measured);
 }
 
 TEST_CASE("Planes, second pass: σ moved, what depends on it is made again") {
@@ -71,11 +75,7 @@ TEST_CASE("Planes, second pass: σ moved, what depends on it is made again") {
   REQUIRE(measured.stats.prior_noise > 0.0);
   CHECK(measured.config.epsilon > 0.05);
   CHECK(measured.stats.direction_fields == 2);
-  ErmsmConfig given;
-  given.noise = measured.config.noise;
-  given.epsilon = measured.config.epsilon;
-  const PlaneDetection once = detectPlanes(scene.map(), given);
-  checkSamePlanes(measured, once);
+  checkSameAsOnePass(scene.map(), measured);
 }
 
 TEST_CASE("Planes, second pass: where the short first search labels too few blocks, the whole one measures σ") {
@@ -88,11 +88,7 @@ TEST_CASE("Planes, second pass: where the short first search labels too few bloc
   CHECK(measured.stats.prior_noise > 0.0);
   CHECK(measured.config.noise > 0.015);
   CHECK(measured.stats.grids_built <= 2);
-  ErmsmConfig given;
-  given.noise = measured.config.noise;
-  given.epsilon = measured.config.epsilon;
-  const PlaneDetection once = detectPlanes(scene.map(), given);
-  checkSamePlanes(measured, once);
+  checkSameAsOnePass(scene.map(), measured);
 }
 
 TEST_CASE("Planes, second pass: directions updated where another level band changed some blocks are the whole field's") {

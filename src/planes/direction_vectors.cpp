@@ -217,16 +217,23 @@ Eigen::Vector3f orientConsistently(const Eigen::Vector3f& normal) {
 
 namespace {
 
+// The window of radius `radius` about `cell`, filled column by column into the scratch
+// `columns` (2 radius + 1 of them at least), `window` pointing at them.
+void fillWindow(const BlockGrid& grid, CellIndex cell, int radius, std::vector<Column>& columns,
+                std::vector<const Column*>& window) {
+  for (int c = 0; c <= 2 * radius; ++c) {
+    fillColumn(grid, columns[static_cast<std::size_t>(c)], cell.i, radius, std::int64_t{cell.j} - radius + c);
+    window[static_cast<std::size_t>(c)] = &columns[static_cast<std::size_t>(c)];
+  }
+}
+
 // One uncertain level block's window, wider a cell at a time from `best` (its window
 // of r cells'): the most certain direction it reaches. `columns`, `window`: scratch of
 // 2 max_radius + 1 columns.
 Direction widened(const BlockGrid& grid, const DirectionConfig& config, double min_spread, const PlaneBlock& block,
                   Direction best, std::vector<Column>& columns, std::vector<const Column*>& window) {
   for (int radius = config.radius + 1; radius <= config.max_radius; ++radius) {
-    for (int c = 0; c <= 2 * radius; ++c) {
-      fillColumn(grid, columns[static_cast<std::size_t>(c)], block.cell.i, radius, std::int64_t{block.cell.j} - radius + c);
-      window[static_cast<std::size_t>(c)] = &columns[static_cast<std::size_t>(c)];
-    }
+    fillWindow(grid, block.cell, radius, columns, window);
     const Direction wider =
         directionOf(block, window.data(), radius, config.height_tolerance, config.corners, grid.cellSize(), min_spread);
     if (wider.tilt < best.tilt) best = wider;
@@ -379,10 +386,7 @@ DirectionField updatedDirectionField(const BlockGrid& grid, const DirectionConfi
     for (std::int64_t n = 0; n < cells; ++n) {
       const std::uint32_t begin = cell_starts[static_cast<std::size_t>(n)];
       const CellIndex here = blocks[begin].cell;
-      for (int c = 0; c <= 2 * radius; ++c) {
-        fillColumn(grid, columns[static_cast<std::size_t>(c)], here.i, radius, std::int64_t{here.j} - radius + c);
-        window[static_cast<std::size_t>(c)] = &columns[static_cast<std::size_t>(c)];
-      }
+      fillWindow(grid, here, radius, columns, window);
       std::vector<std::uint32_t> uncertain_ids;
       for (std::uint32_t id = begin; id < grid.size() && blocks[id].cell == here; ++id) {
         const Direction direction =
