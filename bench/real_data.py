@@ -294,6 +294,24 @@ def authors_scores(data, name, folder, world, labelled, scorer):
     return lines
 
 
+def marked_scores(name, folder, world, owner, labelled, scorer):
+    """Markdown line: the marked surfaces scored as instances with ../shared/peers/score.py
+    (patch precision, recall, F1 at point IoU >= 0.5; points on no marked surface left out, and
+    surfaces of fewer than 300 points; a patch counts where it touches a kept surface). Unlike `share`, IoU also charges a
+    patch for what it takes beyond its surface (a floor patch holding the seats)."""
+    truth_file = os.path.join(folder, "marked.xyz")
+    np.savetxt(truth_file, np.column_stack([world, owner]), fmt="%.5f %.5f %.5f %d")
+    cells = []
+    for method, labels in labelled.items():
+        predicted = os.path.join(folder, "predicted.labels")
+        np.savetxt(predicted, np.asarray(labels, dtype=int), fmt="%d")
+        done, _ = run(["/usr/bin/python3", scorer, truth_file, predicted, "--min-gt-points", "300"])
+        result = json.loads(done.stdout)
+        cells.append(f"{method}: {result['matched']} of {result['gt_planes']}, {result['pred_planes']} patches, "
+                     f"F1 {result['f1']:.2f}")
+    return "- the marked surfaces as instances (IoU >= 0.5, >= 300 points): " + "; ".join(cells)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
@@ -348,8 +366,10 @@ def main():
             labelled["CGAL"] = labels
         text = table(scene, annotation, results)
         scorer = os.path.join(os.path.dirname(a.data), "peers", "score.py")
+        if os.path.exists(scorer):
+            text += "\n" + marked_scores(name, folder, world, owner, labelled, scorer) + "\n"
         if name in AUTHORS_LABELS and os.path.exists(scorer):
-            text += "\n\nScored on the labels the data's authors made (`../shared/peers/score.py`):\n\n"
+            text += "\nScored on the labels the data's authors made (`../shared/peers/score.py`):\n\n"
             text += "\n".join(authors_scores(a.data, name, folder, world, labelled, scorer)) + "\n"
         print(text, flush=True)
         report.append(text)

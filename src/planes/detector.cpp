@@ -50,7 +50,8 @@ Detector::Detector(const BlockGrid& grid, const DirectionField& field, const Erm
       scorer_(grid, field.vectors, config.epsilon, radians(config.kappa_deg), config.threads),
       min_score_(config.min_area / (grid.cellSize() * grid.cellSize())),
       patch_threads_(teamSize(patchPassThreads(grid, config.threads))),
-      sheet_step_(sheets ? sheetStep(config.noise, grid.cellSize()) : std::numeric_limits<double>::infinity()) {
+      sheet_step_(sheets ? sheetStep(config.noise, grid.cellSize()) : std::numeric_limits<double>::infinity()),
+      fit_noise_(sheets ? config.noise : 0.0) {
   patches_.labels.assign(grid.size(), 0);
   FillVector<std::uint8_t> directed(grid.size());
   const auto blocks = static_cast<std::int64_t>(grid.size());
@@ -75,7 +76,7 @@ void Detector::describePatches() {
     Patch patch;
     patch.blocks = std::move(patches_.blocks[k]);
     patch.surface = undescribed_[k].surface;
-    Plane described = describePatch(grid_, patch, undescribed_[k].reference, kappa);
+    Plane described = describePatch(grid_, patch, undescribed_[k].reference, kappa, fit_noise_);
     Plane& plane = patches_.planes[k];
     described.id = plane.id;
     described.source = plane.source;
@@ -214,7 +215,11 @@ bool Detector::accept(std::size_t index) {
   const double kappa = radians(config_.kappa_deg);
   const std::vector<std::uint32_t> strict = scorer_.matching(accepted.plane);
   const bool level = std::abs(accepted.plane.normal.z()) >= std::cos(radians(45.0));
-  if ((level && !liesOnPlane(accepted.plane, strict)) ||
+  // A level plane that climbs in steps is a ramp through stair treads (patch_rules.hpp);
+  // tilted less than κ / 2, it is a level surface's fit, which its edge blocks lean.
+  if ((level && (!liesOnPlane(accepted.plane, strict) ||
+                 climbsInSteps(grid_, strict, accepted.plane, config_.noise, 0.5 * kappa,
+                               static_cast<std::size_t>(std::max(config_.min_patch_blocks, 1))))) ||
       (spreadExceeds(grid_, directions_, strict, accepted.plane, config_.max_direction_spread_deg, patch_threads_) &&
        !(level && (nearlyLevel(accepted.plane) || noiseExplainsSpread(accepted.plane, strict))))) {
     refused_.push_back(accepted.plane);
@@ -352,7 +357,7 @@ PatchSet Detector::run(ErmsmStats& stats) {
   // half a cell further apart than ε allows a block. Where they sit at their points, a
   // piece further off than a sheet's step is another layer (sheets.hpp).
   mergeCoplanar(grid_, patches_, std::min(config_.epsilon + 0.5 * grid_.cellSize(), sheet_step_),
-                radians(config_.kappa_deg));
+                radians(config_.kappa_deg), fit_noise_);
   stats.stages.merges = secondsSince(merge_start);
   // Classification reads the outlines: the patches' and the merged groups' traced now.
   const auto outline_start = Clock::now();

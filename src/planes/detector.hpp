@@ -74,6 +74,9 @@ class Detector {
   // centres (maps before format 3), where a wall on a cell boundary is two columns a cell
   // apart.
   double sheet_step_;
+  // m: σ for the patches' fits (describePatch), where it is known (given, or measured
+  // by a first pass); 0 on a pass that measures it.
+  double fit_noise_;
   std::vector<std::uint32_t> seedable_;  // blocks with a direction vector, in map order; taken ones pruned now and then
   std::size_t seedable_taken_ = 0;       // of which taken
   std::vector<Candidate> candidates_;    // L_c

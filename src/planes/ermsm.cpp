@@ -192,7 +192,7 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   PatchSet patches = detector.run(stats);
   stage();
   classifyPlanes(patches.planes);
-  mergeLevels(grid, patches, radians(config.kappa_deg));
+  mergeLevels(grid, patches, radians(config.kappa_deg), sheets ? config.noise : 0.0);
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));  // the merged levels'
   stats.stages.merges += stage();
   detection.planes = std::move(patches.planes);

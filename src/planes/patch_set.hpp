@@ -35,8 +35,11 @@ struct PatchSet {
 
 // A Plane for the patch: refitted on its own blocks (two tables at slightly different
 // heights keep their own offsets) unless that fit is ill-defined or leaves `reference`
-// by more than κ; area, RMS, the outline moved onto the patch's own plane.
-Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad);
+// by more than κ; area, RMS, the outline moved onto the patch's own plane. Where the map
+// keeps the blocks' points, the plane and RMS are their own, without the blocks thicker
+// than 2 `noise` (σ, m; 0: all blocks) along it: those hold a second surface's points.
+Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad,
+                    double noise);
 
 // Traces the pending outlines (each plane on its own, on `threads` threads, 0 =
 // OpenMP's default) and moves them onto their planes as describePatch would have.
@@ -44,12 +47,14 @@ void tracePendingOutlines(const BlockGrid& grid, PatchSet& set, int threads);
 
 // Patches of one real plane found apart (a refit that tilted a little, a wall on a
 // cell boundary) are merged when they are coplanar within ε, parallel within κ / 2
-// and touch on the grid. A merged group's outline is left pending.
-void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad);
+// and touch on the grid; level ones meet at one height where they meet cell to cell, and
+// (`noise` > 0) their points lie about one plane within a sheet's step. A merged group's
+// outline is left pending; `noise` σ, m, as describePatch's.
+void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad, double noise);
 
 // After classification: floor and ceiling patches are one level each, however far
 // apart (a floor seen between furniture, a ceiling either side of a beam). A merged
 // level's outline is left pending.
-void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad);
+void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad, double noise);
 
 }  // namespace mlmap
