@@ -78,17 +78,18 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
   }
 }
 
-// The RMS distance of two patches' points from the least-squares plane through all of
-// them; nullopt where the map keeps no points.
-std::optional<double> jointPointsRms(const BlockGrid& grid, const std::vector<std::uint32_t>& first,
-                                     const std::vector<std::uint32_t>& second) {
+// A patch's points' moments about `origin` (a map's cell centre at z 0): patches' moments
+// about one origin add up to their union's.
+PointMoments patchMoments(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& origin) {
   PointMoments points;
-  const Eigen::Vector3d origin = (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[first.front()].cell), 0.0).finished();
-  for (const auto* blocks : {&first, &second}) {
-    for (const std::uint32_t id : *blocks) {
-      points.add(grid.pointsOf(id), (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[id].cell), 0.0).finished() - origin);
-    }
+  for (const std::uint32_t id : blocks) {
+    points.add(grid.pointsOf(id), (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[id].cell), 0.0).finished() - origin);
   }
+  return points;
+}
+
+// The RMS distance of points from their least-squares plane; nullopt for fewer than 3.
+std::optional<double> planeRms(const PointMoments& points) {
   if (points.count < 3.0) return std::nullopt;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(points.covariance(), Eigen::EigenvaluesOnly);
@@ -234,23 +235,22 @@ Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePl
   // (tests/test_planes_stairs.cpp). 3 σ: a level block's points lie at most half its
   // depth (the level band, 5 σ) below its top.
   const double cut = noise > 0.0 ? 3.0 * noise : std::numeric_limits<double>::infinity();
+  std::vector<PointStats> stats(patch.blocks.size());
+  std::vector<Eigen::Vector3d> centres(patch.blocks.size());
   std::vector<char> off(patch.blocks.size(), 0);
   double kept = 0.0;
   for (std::size_t k = 0; k < patch.blocks.size(); ++k) {
     const std::uint32_t id = patch.blocks[k];
-    const PointStats stats = grid.pointsOf(id);
-    if (stats.empty()) continue;
-    const Eigen::Vector3d mean =
-        (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[id].cell), 0.0).finished() + stats.mean();
-    off[k] = std::abs(normal.dot(mean - point)) > cut;
-    if (!off[k]) kept += stats.count;
+    stats[k] = grid.pointsOf(id);
+    centres[k] = (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[id].cell), 0.0).finished();
+    if (stats[k].empty()) continue;
+    off[k] = std::abs(normal.dot(centres[k] + stats[k].mean() - point)) > cut;
+    if (!off[k]) kept += stats[k].count;
   }
   if (kept < 3.0) std::fill(off.begin(), off.end(), 0);
   PointMoments points;
   for (std::size_t k = 0; k < patch.blocks.size(); ++k) {
-    if (off[k]) continue;
-    const std::uint32_t id = patch.blocks[k];
-    points.add(grid.pointsOf(id), (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[id].cell), 0.0).finished() - origin);
+    if (!off[k]) points.add(stats[k], centres[k] - origin);
   }
   std::optional<double> points_rms;
   if (points.count >= 3.0) {
@@ -317,6 +317,11 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
     return k;
   };
   const double cos_parallel = std::cos(0.5 * kappa_rad);
+  // Each patch's points' moments, summed once when a pair first needs them.
+  std::vector<std::optional<PointMoments>> moments(count);
+  const Eigen::Vector3d origin =
+      grid.size() > 0 ? (Eigen::Vector3d() << grid.cellCentre(grid.blocks().front().cell), 0.0).finished()
+                      : Eigen::Vector3d::Zero();
   const auto level = [](const Plane& plane) { return std::abs(plane.normal.z()) >= std::cos(std::numbers::pi / 4.0); };
   // Pieces closer than a table leg's width are one surface.
   const int touch_radius = std::max(2, static_cast<int>(std::ceil(0.3 / grid.cellSize())));
@@ -380,7 +385,15 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
       // where the pieces' own RMS is larger it speaks for their surface (the simulated lab at
       // 10 cm cells: walls 1 cm, σ read 0.4 cm).
       if (touching && noise > 0.0) {
-        const std::optional<double> joint = jointPointsRms(grid, set.blocks[a], set.blocks[b]);
+        const auto momentsOf = [&](std::size_t k) -> const PointMoments& {
+          if (!moments[k]) moments[k] = patchMoments(grid, set.blocks[k], origin);
+          return *moments[k];
+        };
+        PointMoments both = momentsOf(a);
+        both.count += momentsOf(b).count;
+        both.sum += momentsOf(b).sum;
+        both.outer += momentsOf(b).outer;
+        const std::optional<double> joint = planeRms(both);
         const double own = std::max(first.rms, second.rms);
         const double half_step = 1.5 * std::numbers::sqrt2 * std::max(noise, own);
         touching = !joint || *joint <= std::hypot(own, half_step);
