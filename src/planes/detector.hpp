@@ -18,6 +18,7 @@
 #include "mlmap/planes/direction_vectors.hpp"
 #include "mlmap/planes/ermsm.hpp"
 #include "outline_runs.hpp"
+#include "patch_merges.hpp"
 #include "patch_set.hpp"
 #include "plane_scorer.hpp"
 

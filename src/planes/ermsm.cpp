@@ -13,6 +13,7 @@
 #include "mlmap/planes/block_grid.hpp"
 #include "mlmap/planes/classify.hpp"
 #include "mlmap/planes/direction_vectors.hpp"
+#include "patch_merges.hpp"
 #include "patch_set.hpp"
 #include "surface_noise.hpp"
 

@@ -1,0 +1,21 @@
+// Internal to eRMSM, beyond the paper: merging the patches of one surface that the search
+// accepted apart (coplanar pieces, the pieces of a floor or a ceiling).
+#pragma once
+
+#include "patch_set.hpp"
+
+namespace mlmap {
+
+// Patches of one real plane found apart (a refit that tilted a little, a wall on a
+// cell boundary) are merged when they are coplanar within ε, parallel within κ / 2
+// and touch on the grid; level ones meet at one height where they meet cell to cell, and
+// (`noise` > 0) their points lie about one plane within a sheet's step. A merged group's
+// outline is left pending; `noise` σ, m, as describePatch's.
+void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad, double noise);
+
+// After classification: floor and ceiling patches are one level each, however far
+// apart (a floor seen between furniture, a ceiling either side of a beam). A merged
+// level's outline is left pending.
+void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad, double noise);
+
+}  // namespace mlmap
