@@ -215,11 +215,7 @@ bool Detector::accept(std::size_t index) {
   const double kappa = radians(config_.kappa_deg);
   const std::vector<std::uint32_t> strict = scorer_.matching(accepted.plane);
   const bool level = std::abs(accepted.plane.normal.z()) >= std::cos(radians(45.0));
-  // A level plane that climbs in steps is a ramp through stair treads (patch_rules.hpp);
-  // tilted less than κ / 2, it is a level surface's fit, which its edge blocks lean.
-  if ((level && (!liesOnPlane(accepted.plane, strict) ||
-                 climbsInSteps(grid_, strict, accepted.plane, config_.noise, 0.5 * kappa,
-                               static_cast<std::size_t>(std::max(config_.min_patch_blocks, 1))))) ||
+  if ((level && !liesOnPlane(accepted.plane, strict)) ||
       (spreadExceeds(grid_, directions_, strict, accepted.plane, config_.max_direction_spread_deg, patch_threads_) &&
        !(level && (nearlyLevel(accepted.plane) || noiseExplainsSpread(accepted.plane, strict))))) {
     refused_.push_back(accepted.plane);

@@ -1,7 +1,6 @@
 #include "patch_rules.hpp"
 
 #include <Eigen/Eigenvalues>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -85,43 +84,6 @@ double directionSpread(const BlockGrid& grid, const std::vector<Eigen::Vector3f>
     weight += grid.blocks()[id].surface;
   }
   return weight > 0.0 ? weighted / weight * 180.0 / std::numbers::pi : 0.0;
-}
-
-bool climbsInSteps(const BlockGrid& grid, const std::vector<std::uint32_t>& ids, const CandidatePlane& plane,
-                   double noise, double min_tilt_rad, std::size_t min_pairs) {
-  const Eigen::Vector3d normal = plane.normal.cast<double>();
-  if (std::abs(normal.z()) < 1e-3 || std::abs(normal.z()) > std::cos(min_tilt_rad)) return false;
-  // The plane's rise per metre across: z = z₀ + slope · (x, y).
-  const Eigen::Vector2d slope = -normal.head<2>() / normal.z();
-  IdSet members(grid.blocks().size());
-  for (const std::uint32_t id : ids) members.insert(id);
-  std::size_t pairs = 0;
-  std::size_t climbing = 0;
-  for (const std::uint32_t id : ids) {
-    const PlaneBlock& block = grid.blocks()[id];
-    if (block.vertical) continue;
-    // Each pair of neighbouring cells once: the next cell along i and along j.
-    const auto visit = [&](std::uint32_t other_id) {
-      const PlaneBlock& other = grid.blocks()[other_id];
-      if (other.vertical || !members.contains(other_id)) return;
-      const Eigen::Vector2d across = (other.point.head<2>() - block.point.head<2>()).cast<double>();
-      const double rise = slope.dot(across);
-      // A block's height is the mean of its points: the difference of two is off by
-      // σ_d = σ √(1/n₁ + 1/n₂). Only pairs the plane rises 4 σ_d across count: a ramp's
-      // pair then rises less than half as much by a chance of 2 % (a majority of them far
-      // less).
-      if (std::abs(rise) < 4.0 * noise * std::sqrt(2.0)) {
-        const double counts = 1.0 / std::max<std::uint32_t>(grid.pointsOf(id).count, 1) +
-                              1.0 / std::max<std::uint32_t>(grid.pointsOf(other_id).count, 1);
-        if (std::abs(rise) < 4.0 * noise * std::sqrt(counts)) return;
-      }
-      ++pairs;
-      if (std::abs(static_cast<double>(other.point.z() - block.point.z()) - rise) < 0.5 * std::abs(rise)) ++climbing;
-    };
-    grid.forEachInCells(std::int64_t{block.cell.i} + 1, std::int64_t{block.cell.i} + 1, block.cell.j, block.cell.j, visit);
-    grid.forEachInCells(block.cell.i, block.cell.i, std::int64_t{block.cell.j} + 1, std::int64_t{block.cell.j} + 1, visit);
-  }
-  return pairs >= min_pairs && 2 * climbing < pairs;
 }
 
 std::size_t fitPoints(const BlockGrid& grid, const Patch& patch) {

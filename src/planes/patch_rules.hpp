@@ -50,19 +50,6 @@ inline double spreadLimit(double max_deg, double noise_deg) { return std::hypot(
 // neighbouring object pulls away.
 double medianDistance(const BlockGrid& grid, const std::vector<std::uint32_t>& ids, const CandidatePlane& plane);
 
-// Whether a tilted plane climbs in steps: a ramp laid through the edges of stair treads,
-// which the blocks' direction vectors follow where their windows span two treads (at 10
-// cm cells: plane_seg's ANYmal stairs, 18-26° through 16.5 cm risers on 26 cm treads).
-// Between neighbouring level blocks the plane rises by `rise`; on a ramp each pair's
-// heights differ by about that much, on stairs most pairs lie on one tread (no rise) or
-// across a riser (far more). The plane climbs in steps when fewer than half of the pairs
-// (of at least `min_pairs`) rise within half of theirs. Only pairs the plane rises
-// enough across for noise not to hide it count (patch_rules.cpp), and only planes
-// tilted beyond `min_tilt_rad`: a level tread's fit leans 3-5.5° towards the riser edges
-// beside it (tests/test_planes_stairs.cpp), and its blocks do not follow that lean.
-bool climbsInSteps(const BlockGrid& grid, const std::vector<std::uint32_t>& ids, const CandidatePlane& plane,
-                   double noise, double min_tilt_rad, std::size_t min_pairs);
-
 // The points a patch's plane is fitted to (PcaSums::addBlock): one per level block, two
 // per vertical block (its top and its bottom). A patch needs ErmsmConfig::min_patch_blocks
 // of them: a wall's face three cells wide is as well determined as a floor's six cells,
