@@ -41,10 +41,14 @@ std::vector<Point> structuredCloud(unsigned seed) {
   return cloud;
 }
 
+// `chunks` > 1 adds the cloud in that many slices (the map's voxel and block indices grow).
 void checkAgainstBruteForce(const std::vector<Point>& cloud, double voxel_size, double max_distance,
-                            unsigned seed, double extent) {
+                            unsigned seed, double extent, std::size_t chunks = 1) {
   VoxelHashMap map(voxel_size, cloud.size());  // no per-voxel cap: every point is kept
-  map.addPoints(cloud);
+  for (std::size_t c = 0; c < chunks; ++c) {
+    map.addPoints(std::vector<Point>(cloud.begin() + static_cast<long>(c * cloud.size() / chunks),
+                                     cloud.begin() + static_cast<long>((c + 1) * cloud.size() / chunks)));
+  }
   REQUIRE(map.size() == cloud.size());
   std::mt19937 generator(seed);
   std::uniform_real_distribution<double> coordinate(-0.5, extent + 0.5);
@@ -89,6 +93,18 @@ TEST_CASE("VoxelHashMap: nearest and within match brute force on a structured cl
   const std::vector<Point> cloud = structuredCloud(5);
   checkAgainstBruteForce(cloud, 0.1, 0.08, 6, 3.0);
   checkAgainstBruteForce(cloud, 0.05, 0.3, 7, 3.0);
+}
+
+TEST_CASE("VoxelHashMap: wide gates (searched by blocks) match brute force, also after adding in parts") {
+  // Gates of many voxels, as the wide ICP basin uses (up to 2 m at 0.1 m voxels): most queries
+  // anywhere around the cloud then find a far point or, beyond the gate, none.
+  const std::vector<Point> cloud = structuredCloud(8);
+  checkAgainstBruteForce(cloud, 0.1, 1.5, 9, 3.0);
+  checkAgainstBruteForce(cloud, 0.1, 0.45, 10, 3.0, 3);
+  checkAgainstBruteForce(cloud, 0.05, 0.8, 11, 3.0, 5);
+  const mlmap::Scan scan = mlmap::test::randomScan(400, 12, 2.0);  // sparse, across negative keys
+  checkAgainstBruteForce(scan.points, 0.1, 2.0, 13, 2.0, 4);
+  checkAgainstBruteForce(scan.points, 0.1, 0.25, 14, 2.0, 2);
 }
 
 TEST_CASE("VoxelHashMap: voxels keep at most max points, empty map finds nothing") {
