@@ -205,6 +205,13 @@ void VoxelHashMap::visitBlocks(const Point& query, double radius, Visit&& visit)
       (Eigen::Vector3d(own.x - kBlock * own_block.x, own.y - kBlock * own_block.y, own.z - kBlock * own_block.z) +
        fraction) / static_cast<double>(kBlock);
   double limit_sq = radius * radius * inverse_size_ * inverse_size_;  // in voxels²
+  // The query's own voxel first: a near answer there shrinks the radius before the blocks'
+  // voxels, visited in storage order, are.
+  const std::uint32_t own_voxel = table_.find(own);
+  if (own_voxel != VoxelTable::kMissing) {
+    const double next_radius = visit(own_voxel);
+    limit_sq = next_radius * next_radius * inverse_size_ * inverse_size_;
+  }
   const auto visitBlock = [&](std::int32_t bx, std::int32_t by, std::int32_t bz) {
     const VoxelKey key{own_block.x + bx, own_block.y + by, own_block.z + bz};
     if (key.x < low.x || key.x > high.x || key.y < low.y || key.y > high.y || key.z < low.z || key.z > high.z) return;
@@ -215,6 +222,7 @@ void VoxelHashMap::visitBlocks(const Point& query, double radius, Visit&& visit)
     if (block == VoxelTable::kMissing) return;
     for (std::uint32_t k = block_begin_[block]; k < block_begin_[block + 1]; ++k) {
       const std::uint32_t voxel = block_voxels_[k];
+      if (voxel == own_voxel) continue;
       const VoxelKey& at = table_.key(voxel);
       const double vx = cellGap(at.x - own.x, fraction.x()), vy = cellGap(at.y - own.y, fraction.y()),
                    vz = cellGap(at.z - own.z, fraction.z());
