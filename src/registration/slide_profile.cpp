@@ -18,9 +18,11 @@ constexpr double kFacing = 0.8660254;
 // true peak then counts hundreds (the lab's: 38 % of them, 0.2 % away from it), which stand
 // out at 3 standard errors; more only cost time.
 constexpr std::size_t kMaxProfilePoints = 1000;
-// fitSlide: at most this many re-matching steps (each moves matches by its own step, so the
-// shift settles in 2-3 from a profile peak ±2·3σ wide).
+// fitSlide: at most this many re-matching steps, and it stops at a step under this (m, as
+// IcpConfig::convergence_translation). A bound on the cost, not a tuned figure: each step is
+// one lookup per facing point (tens along a corridor, at most a few thousand in a room).
 constexpr int kMaxFitSteps = 10;
+constexpr double kFitConverged = 1e-4;
 
 // a stands out from b: their difference is at least 3 standard errors of two counts.
 bool standsOut(std::size_t a, std::size_t b) {
@@ -105,8 +107,7 @@ SlideFit fitSlide(const std::vector<Point>& source, const std::vector<Eigen::Vec
   }
   const double gate = std::max(bound, target.voxelSize());
   double shift = 0.0;
-  // Gauss-Newton in one unknown: a few steps (each re-matches), until a step is under a
-  // tenth of a millimetre.
+  // Gauss-Newton in one unknown, re-matching at each step.
   for (int step = 0; step < kMaxFitSteps; ++step) {
     double sum_ar = 0.0, sum_aa = 0.0, sum_rr = 0.0;
     std::size_t count = 0;
@@ -129,7 +130,7 @@ SlideFit fitSlide(const std::vector<Point>& source, const std::vector<Eigen::Vec
     const double variance = std::max(0.0, sum_rr - sum_ar * sum_ar / sum_aa) / static_cast<double>(count - 1);
     fit.standard_error = std::sqrt(variance / sum_aa);
     shift += delta;
-    if (std::abs(delta) < 1e-4) break;
+    if (std::abs(delta) < kFitConverged) break;
   }
   fit.shift = shift;
   fit.fitted = true;
