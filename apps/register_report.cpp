@@ -68,6 +68,7 @@ void writeRegisterReport(const std::string& path, const std::vector<ScanReport>&
                                                {"best_shift_m", r.check.profile.best_shift},
                                                {"peaked", r.check.profile.peaked}}},
                             {"slide_retries", r.slides},
+                            {"slide_fit_m", r.slide_fit},
                             {"verified", r.verified},
                             {"unconstrained", r.unconstrained},
                             {"no_overlap", r.no_overlap},

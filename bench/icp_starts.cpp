@@ -105,6 +105,7 @@ int runIcpStarts(int argc, char** argv) {
         run["unconstrained"] = result.unconstrained;
         run["no_overlap"] = result.no_overlap;
         run["slides"] = result.slides;
+        run["slide_fit"] = result.slide_fit;
         const SlideProfile& profile = result.check.profile;
         run["profile"] = {{"facing", profile.facing}, {"at_result", profile.at_result}, {"away", profile.away},
                           {"best", profile.best}, {"best_shift", profile.best_shift}, {"peaked", profile.peaked}};

@@ -1,6 +1,7 @@
 // VoxelHashMap: every query against brute force, on random and structured clouds.
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -41,10 +42,14 @@ std::vector<Point> structuredCloud(unsigned seed) {
   return cloud;
 }
 
+// `chunks` > 1 adds the cloud in that many slices (the map's voxel and block indices grow).
 void checkAgainstBruteForce(const std::vector<Point>& cloud, double voxel_size, double max_distance,
-                            unsigned seed, double extent) {
+                            unsigned seed, double extent, std::size_t chunks = 1) {
   VoxelHashMap map(voxel_size, cloud.size());  // no per-voxel cap: every point is kept
-  map.addPoints(cloud);
+  for (std::size_t c = 0; c < chunks; ++c) {
+    map.addPoints(std::vector<Point>(cloud.begin() + static_cast<long>(c * cloud.size() / chunks),
+                                     cloud.begin() + static_cast<long>((c + 1) * cloud.size() / chunks)));
+  }
   REQUIRE(map.size() == cloud.size());
   std::mt19937 generator(seed);
   std::uniform_real_distribution<double> coordinate(-0.5, extent + 0.5);
@@ -89,6 +94,18 @@ TEST_CASE("VoxelHashMap: nearest and within match brute force on a structured cl
   const std::vector<Point> cloud = structuredCloud(5);
   checkAgainstBruteForce(cloud, 0.1, 0.08, 6, 3.0);
   checkAgainstBruteForce(cloud, 0.05, 0.3, 7, 3.0);
+}
+
+TEST_CASE("VoxelHashMap: wide gates (searched by blocks) match brute force, also after adding in parts") {
+  // Gates of many voxels, as the wide ICP basin uses (up to 2 m at 0.1 m voxels): most queries
+  // anywhere around the cloud then find a far point or, beyond the gate, none.
+  const std::vector<Point> cloud = structuredCloud(8);
+  checkAgainstBruteForce(cloud, 0.1, 1.5, 9, 3.0);
+  checkAgainstBruteForce(cloud, 0.1, 0.45, 10, 3.0, 3);
+  checkAgainstBruteForce(cloud, 0.05, 0.8, 11, 3.0, 5);
+  const mlmap::Scan scan = mlmap::test::randomScan(400, 12, 2.0);  // sparse, across negative keys
+  checkAgainstBruteForce(scan.points, 0.1, 2.0, 13, 2.0, 4);
+  checkAgainstBruteForce(scan.points, 0.1, 0.25, 14, 2.0, 2);
 }
 
 TEST_CASE("VoxelHashMap: voxels keep at most max points, empty map finds nothing") {
@@ -196,4 +213,44 @@ TEST_CASE("VoxelHashMap: a sparse plane gets normals from a grown neighbourhood,
   }
   CHECK(fixed_normals == 0);
   CHECK(grown_facing > static_cast<int>(all.size()) * 8 / 10);
+}
+
+TEST_CASE("VoxelHashMap: a grown neighbourhood gives the normal of that radius, to the bit") {
+  // Two noisy planes sampled sparsely at random (~11 points per m², 1.5 m apart): at 0.1 m voxels
+  // most neighbourhoods up to 0.2 m hold fewer than 6 points, so normals grow to 0.4 or 0.8 m
+  // (whose voxels are found by blocks, not by a stencil lookup per offset). Each grown normal
+  // must be, to the bit, that of a map estimated at the radius where it stopped growing: the
+  // first of 0.1, 0.2, 0.4, 0.8 m that gives one (no corner within 0.8 m: no neighbourhood there
+  // is dense enough yet not planar).
+  std::mt19937 generator(21);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  std::uniform_real_distribution<double> along(0.0, 6.0), across(0.0, 4.0);
+  std::vector<Point> cloud;
+  for (int k = 0; k < 260; ++k) {
+    const double a = along(generator), b = across(generator);
+    cloud.emplace_back(a, b, 0.2 * a + noise(generator));
+    cloud.emplace_back(-1.5 + noise(generator), a - 3.0, b);
+  }
+  VoxelHashMap grown(0.1);
+  grown.addPoints(cloud);
+  grown.estimateNormals({.radius = 0.1, .max_radius = 0.8});
+  std::vector<VoxelHashMap> fixed;
+  for (const double radius : {0.1, 0.2, 0.4, 0.8}) {
+    fixed.emplace_back(0.1);
+    fixed.back().addPoints(cloud);
+    fixed.back().estimateNormals({.radius = radius});
+  }
+  std::array<int, 5> stopped{};  // at each radius, or never
+  for (const Point& point : cloud) {
+    const auto normal = grown.nearest(point, 0.0);
+    REQUIRE(normal);
+    std::size_t level = 0;
+    while (level < fixed.size() && fixed[level].nearest(point, 0.0)->normal.isZero()) ++level;
+    ++stopped[level];
+    CHECK(normal->normal == (level < fixed.size() ? fixed[level].nearest(point, 0.0)->normal : Eigen::Vector3d::Zero()));
+  }
+  CAPTURE(stopped[0]);
+  CAPTURE(stopped[4]);
+  CHECK(stopped[2] > 50);  // both grown radii exercised
+  CHECK(stopped[3] > 50);
 }

@@ -18,6 +18,11 @@ constexpr double kFacing = 0.8660254;
 // true peak then counts hundreds (the lab's: 38 % of them, 0.2 % away from it), which stand
 // out at 3 standard errors; more only cost time.
 constexpr std::size_t kMaxProfilePoints = 1000;
+// fitSlide: at most this many re-matching steps, and it stops at a step under this (m, as
+// IcpConfig::convergence_translation). A bound on the cost, not a tuned figure: each step is
+// one lookup per facing point (tens along a corridor, at most a few thousand in a room).
+constexpr int kMaxFitSteps = 10;
+constexpr double kFitConverged = 1e-4;
 
 // a stands out from b: their difference is at least 3 standard errors of two counts.
 bool standsOut(std::size_t a, std::size_t b) {
@@ -88,6 +93,48 @@ SlideProfile slideProfile(const std::vector<Point>& source, const std::vector<Ei
   profile.peaked = standsOut(profile.at_result, profile.away);
   profile.better_elsewhere = standsOut(profile.best, profile.at_result);
   return profile;
+}
+
+SlideFit fitSlide(const std::vector<Point>& source, const std::vector<Eigen::Vector3d>& source_normals,
+                  const VoxelHashMap& target, const Pose& pose, const Eigen::Vector3d& direction, double bound,
+                  std::size_t min_points) {
+  SlideFit fit;
+  if (source_normals.size() != source.size() || !(bound > 0.0) || direction.isZero()) return fit;
+  const Eigen::Vector3d d = direction.normalized();
+  std::vector<Point> facing;  // moved to the target frame at the pose
+  for (std::size_t k = 0; k < source.size(); ++k) {
+    if (std::abs((pose.linear() * source_normals[k]).dot(d)) >= kFacing) facing.push_back(pose * source[k]);
+  }
+  const double gate = std::max(bound, target.voxelSize());
+  double shift = 0.0;
+  // Gauss-Newton in one unknown, re-matching at each step.
+  for (int step = 0; step < kMaxFitSteps; ++step) {
+    double sum_ar = 0.0, sum_aa = 0.0, sum_rr = 0.0;
+    std::size_t count = 0;
+    for (const Point& point : facing) {
+      const Point moved = point + shift * d;
+      const std::optional<Neighbour> neighbour = target.nearest(moved, gate);
+      if (!neighbour) continue;
+      const double a = neighbour->normal.dot(d);
+      if (std::abs(a) < kFacing) continue;
+      const double r = neighbour->normal.dot(moved - neighbour->point);
+      if (std::abs(r) > bound) continue;
+      sum_ar += a * r;
+      sum_aa += a * a;
+      sum_rr += r * r;
+      ++count;
+    }
+    fit.points = count;
+    if (count < std::max<std::size_t>(2, min_points)) return SlideFit{.points = count};
+    const double delta = -sum_ar / sum_aa;
+    const double variance = std::max(0.0, sum_rr - sum_ar * sum_ar / sum_aa) / static_cast<double>(count - 1);
+    fit.standard_error = std::sqrt(variance / sum_aa);
+    shift += delta;
+    if (std::abs(delta) < kFitConverged) break;
+  }
+  fit.shift = shift;
+  fit.fitted = true;
+  return fit;
 }
 
 CloudSurfaces cloudSurfaces(const std::vector<Point>& points, double voxel_size) {

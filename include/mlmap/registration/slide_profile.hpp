@@ -45,6 +45,22 @@ SlideProfile slideProfile(const std::vector<Point>& source, const std::vector<Ei
                           const Eigen::Matrix3d& translation_information, double bound, double lowest,
                           double highest, double step);
 
+// Where along `direction` (unit, target frame) the source points whose own surface faces it
+// sit best on target surfaces facing it: the shift s (m) minimising the squared point-to-plane
+// residuals of those within `bound` of their match, re-matched at each step from `pose`. Only
+// such points measure a slide along a corridor (the walls' leaning normals would pull too); the
+// slide profile counts them at steps of 2σ, this fits them. No shift when fewer than
+// `min_points` match.
+struct SlideFit {
+  double shift = 0.0;           // m, along the direction
+  double standard_error = 0.0;  // m, of the shift (residual spread over √Σ(n·d)²)
+  std::size_t points = 0;       // matched facing points at the last step
+  bool fitted = false;
+};
+SlideFit fitSlide(const std::vector<Point>& source, const std::vector<Eigen::Vector3d>& source_normals,
+                  const VoxelHashMap& target, const Pose& pose, const Eigen::Vector3d& direction, double bound,
+                  std::size_t min_points);
+
 // One normal per point of `points` (their own neighbourhood's PCA normal, zero where it is
 // not planar), and the cloud's surface noise (VoxelHashMap::surfaceNoise), from one voxel
 // hash of the points at `voxel_size` with normals over twice that radius, grown up to 8 voxels

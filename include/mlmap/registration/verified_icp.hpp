@@ -7,6 +7,8 @@
 // (the first gate set from the start's error bound and the cloud's radius), then other
 // starts (yaw and translation offsets about the given one); the best-explained result is
 // kept. A first run that matches almost nothing means the clouds do not overlap: no retry.
+// A verified result whose weakest direction only a few points measure (a corridor's axis) is
+// moved along it to where those points fit (fitSlide), when they measure that clearly.
 #pragma once
 
 #include <cstddef>
@@ -90,6 +92,7 @@ struct VerifiedIcp {
   double source_noise = 0.0;   // m, the source noise used
   int attempts = 0;            // ICP runs (1: no retry)
   int slides = 0;              // of them started where the slide profile peaked
+  double slide_fit = 0.0;      // m, the kept result moved along its weakest direction by fitSlide
   double first_matched_share = 0.0;  // of the first run: source points matched within the gate
   bool verified = false;       // explains the overlap and the geometry constrains every direction
   bool unconstrained = false;  // explains the overlap but leaves a direction free (a corridor)

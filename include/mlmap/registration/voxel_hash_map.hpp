@@ -2,7 +2,9 @@
 // octomap::OcTreeKey at the map resolution, i.e. floor(c / resolution) (a voxel hash, like
 // KISS-ICP's VoxelHashMap), in a flat VoxelTable. A query visits only the voxels its search
 // sphere's bounding box overlaps, nearest first, and skips voxels farther than the best
-// point found so far. Each voxel keeps the moments of its points, so a normal is a sum of a
+// point found so far; a wide search (a gate of decimetres to metres, far beyond the voxel)
+// visits blocks of 4³ voxels instead and looks only into the occupied ones, so a query that
+// finds nothing costs the blocks its sphere overlaps, not every voxel. Each voxel keeps the moments of its points, so a normal is a sum of a
 // few neighbouring voxels' moments and one 3×3 eigen-decomposition, not a radius search.
 #pragma once
 
@@ -84,6 +86,9 @@ class VoxelHashMap {
   };
   template <typename Visit>
   void visitVoxels(const Point& query, double radius, Visit&& visit) const;
+  template <typename Visit>
+  void visitBlocks(const Point& query, double radius, Visit&& visit) const;
+  void indexBlocks();
   Point centreOf(const VoxelKey& key) const;
   std::size_t pointsIn(std::size_t voxel) const { return begin_[voxel + 1] - begin_[voxel]; }
 
@@ -101,6 +106,12 @@ class VoxelHashMap {
   std::vector<char> dirty_;              // gained points since the last estimateNormals()
   std::vector<char> sparse_;             // its normal needed (or lacked) a wider neighbourhood
   std::vector<VoxelKey> stencil_;        // the neighbourhood of the last estimateNormals()
+  // Blocks of 4³ voxels (keys shifted right by 2): which voxels each holds, packed block by
+  // block like the points (block b: block_voxels_[block_begin_[b], block_begin_[b + 1])).
+  VoxelTable blocks_;
+  std::vector<std::uint32_t> voxel_block_;  // per voxel, its block's index
+  std::vector<std::uint32_t> block_begin_{0};
+  std::vector<std::uint32_t> block_voxels_;
 };
 
 }  // namespace mlmap::registration
