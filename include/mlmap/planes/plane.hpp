@@ -21,7 +21,10 @@ struct Plane {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // m, of its blocks' points
   double area = 0.0;                  // m², its blocks' surface
   std::size_t block_count = 0;
-  double rms = 0.0;                   // m, RMS distance of its blocks' points to the plane
+  // m, RMS distance of its blocks' points to the plane, where σ is known without the blocks
+  // whose points lie mostly on another surface (more than 3 σ off: a tread's cell holding
+  // the riser below its top)
+  double rms = 0.0;
   std::vector<Eigen::Vector3d> outline;  // m, boundary polygon on the plane, counter-clockwise
   std::int32_t source = 0;            // the accepted eRMSM plane it was split from (1-based)
   std::int32_t candidates = 0;        // candidates generated before that plane was accepted
