@@ -261,6 +261,21 @@ def picture(points, owner, labelled, out, title):
         pass
 
 
+def scored_cells(scorer, truth_file, folder, labelled):
+    """Each method's labels scored against TRUTH_FILE with ../shared/peers/score.py (IoU >= 0.5,
+    true regions of >= 300 points, patches counted where they touch one): "method: matched of
+    true, patches, F1" joined by "; "."""
+    cells = []
+    for method, labels in labelled.items():
+        predicted = os.path.join(folder, "predicted.labels")
+        np.savetxt(predicted, np.asarray(labels, dtype=int), fmt="%d")
+        done, _ = run(["/usr/bin/python3", scorer, truth_file, predicted, "--min-gt-points", "300"])
+        result = json.loads(done.stdout)
+        cells.append(f"{method}: {result['matched']} of {result['gt_planes']}, {result['pred_planes']} patches, "
+                     f"F1 {result['f1']:.2f}")
+    return "; ".join(cells)
+
+
 # Scenes whose own authors labelled their points (label 0: not labelled), scored beside the
 # project's annotation with the peers' scorer (../shared/peers/score.py: patch precision,
 # recall and F1 at point IoU >= 0.5, unlabelled points left out, only patches touching a
@@ -282,34 +297,19 @@ def authors_scores(data, name, folder, world, labelled, scorer):
         truth[truth == 0] = -1
         truth_file = os.path.join(folder, f"authors_{kind}.xyz")
         np.savetxt(truth_file, np.column_stack([world, truth]), fmt="%.5f %.5f %.5f %d")
-        cells = []
-        for method, labels in labelled.items():
-            predicted = os.path.join(folder, "predicted.labels")
-            np.savetxt(predicted, np.asarray(labels, dtype=int), fmt="%d")
-            done, _ = run(["/usr/bin/python3", scorer, truth_file, predicted, "--min-gt-points", "300"])
-            result = json.loads(done.stdout)
-            cells.append(f"{method}: {result['matched']} of {result['gt_planes']}, {result['pred_planes']} patches, "
-                         f"F1 {result['f1']:.2f}")
-        lines.append(f"- the authors' {kind} (>= 300 points): " + "; ".join(cells))
+        lines.append(f"- the authors' {kind} (>= 300 points): " + scored_cells(scorer, truth_file, folder, labelled))
     return lines
 
 
 def marked_scores(name, folder, world, owner, labelled, scorer):
     """Markdown line: the marked surfaces scored as instances with ../shared/peers/score.py
     (patch precision, recall, F1 at point IoU >= 0.5; points on no marked surface left out, and
-    surfaces of fewer than 300 points; a patch counts where it touches a kept surface). Unlike `share`, IoU also charges a
-    patch for what it takes beyond its surface (a floor patch holding the seats)."""
+    surfaces of fewer than 300 points; a patch counts where it touches a kept surface). Unlike
+    `share`, IoU also charges a patch for what it takes beyond its surface (a floor patch holding
+    the seats)."""
     truth_file = os.path.join(folder, "marked.xyz")
     np.savetxt(truth_file, np.column_stack([world, owner]), fmt="%.5f %.5f %.5f %d")
-    cells = []
-    for method, labels in labelled.items():
-        predicted = os.path.join(folder, "predicted.labels")
-        np.savetxt(predicted, np.asarray(labels, dtype=int), fmt="%d")
-        done, _ = run(["/usr/bin/python3", scorer, truth_file, predicted, "--min-gt-points", "300"])
-        result = json.loads(done.stdout)
-        cells.append(f"{method}: {result['matched']} of {result['gt_planes']}, {result['pred_planes']} patches, "
-                     f"F1 {result['f1']:.2f}")
-    return "- the marked surfaces as instances (IoU >= 0.5, >= 300 points): " + "; ".join(cells)
+    return "- the marked surfaces as instances (IoU >= 0.5, >= 300 points): " + scored_cells(scorer, truth_file, folder, labelled)
 
 
 def main():

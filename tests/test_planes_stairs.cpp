@@ -26,18 +26,45 @@ double tiltDeg(const Eigen::Vector3d& normal) {
   return std::acos(std::min(1.0, std::abs(normal.normalized().z()))) * 180.0 / std::numbers::pi;
 }
 
-// A lower landing, three treads and an upper landing, 2 m wide, sampled every 2 cm
-// with 5 mm of noise; each riser a steep slope of the grid's smoothing.
-test::PlaneSceneBuilder elevationStairs(unsigned seed) {
-  test::PlaneSceneBuilder scene(0.05, 0.005, seed);
-  scene.withNoise(0.005, kFileVariance).floor(-1.5, 0.0, kStart, 2.0, 0.0);
-  for (int step = 0; step <= kTreads; ++step) {
-    const double foot = kStart + step * (kEdge + kTread);
+// A lower landing, `treads` treads and an upper landing, 2 m wide, sampled every 2 cm
+// with `noise`; each riser a steep slope of the grid's smoothing, the first at `start`.
+struct Staircase {
+  double cell = 0.05;   // m
+  double noise = 0.005; // m
+  double start = kStart;
+  int treads = kTreads;
+};
+
+test::PlaneSceneBuilder elevationStairs(const Staircase& stairs, unsigned seed) {
+  test::PlaneSceneBuilder scene(stairs.cell, stairs.noise, seed);
+  scene.withNoise(stairs.noise, kFileVariance).floor(-1.5, 0.0, stairs.start, 2.0, 0.0);
+  for (int step = 0; step <= stairs.treads; ++step) {
+    const double foot = stairs.start + step * (kEdge + kTread);
     scene.rectangle({foot, 0.0, step * kRiser}, {kEdge, 0.0, kRiser}, {0.0, 2.0, 0.0}, 0.02);
-    const double depth = step < kTreads ? kTread : 1.5;  // the upper landing after the last
+    const double depth = step < stairs.treads ? kTread : 1.5;  // the upper landing after the last
     scene.floor(foot + kEdge, 0.0, foot + kEdge + depth, 2.0, (step + 1) * kRiser);
   }
   return scene;
+}
+
+// The largest patch whose centroid lies within 4 cm of `height`, or null.
+const Plane* largestAt(const PlaneDetection& detection, double height) {
+  const Plane* largest = nullptr;
+  for (const Plane& plane : detection.planes) {
+    if (std::abs(plane.centroid.z() - height) > 0.04) continue;
+    if (largest == nullptr || plane.area > largest->area) largest = &plane;
+  }
+  return largest;
+}
+
+// No patch of over 0.2 m² leans through the treads: each within 8° of level or steeper
+// than 60° (a riser).
+void checkNoRamp(const PlaneDetection& detection) {
+  for (const Plane& plane : detection.planes) {
+    CAPTURE(plane.normal.transpose());
+    CAPTURE(plane.centroid.transpose());
+    if (plane.area > 0.2) CHECK((tiltDeg(plane.normal) < 8.0 || tiltDeg(plane.normal) > 60.0));
+  }
 }
 
 }  // namespace
@@ -45,16 +72,12 @@ test::PlaneSceneBuilder elevationStairs(unsigned seed) {
 TEST_CASE("Planes on stairs: each tread of an elevation map read from a file is its own level patch at 5 cm cells") {
   for (const unsigned seed : {1U, 2U}) {
     CAPTURE(seed);
-    test::PlaneSceneBuilder scene = elevationStairs(seed);
+    test::PlaneSceneBuilder scene = elevationStairs(Staircase{}, seed);
     const PlaneDetection detection = detectPlanes(scene.map());
     for (int step = 1; step <= kTreads; ++step) {
       CAPTURE(step);
       const double height = step * kRiser;
-      const Plane* tread = nullptr;
-      for (const Plane& plane : detection.planes) {
-        if (std::abs(plane.centroid.z() - height) > 0.04) continue;
-        if (tread == nullptr || plane.area > tread->area) tread = &plane;
-      }
+      const Plane* tread = largestAt(detection, height);
       REQUIRE(tread != nullptr);
       // Level within 8° (the riser edges beside it pull 3-5.5°), not a ramp (29° from
       // tread to tread), at the tread's height.
@@ -64,12 +87,7 @@ TEST_CASE("Planes on stairs: each tread of an elevation map read from a file is 
       CHECK(tread->area > 0.35);
       CHECK(tread->area < 0.6);
     }
-    // No patch leans through the treads.
-    for (const Plane& plane : detection.planes) {
-      CAPTURE(plane.normal.transpose());
-      CAPTURE(plane.centroid.transpose());
-      if (plane.area > 0.2) CHECK((tiltDeg(plane.normal) < 8.0 || tiltDeg(plane.normal) > 60.0));
-    }
+    checkNoRamp(detection);
   }
 }
 
@@ -82,23 +100,12 @@ TEST_CASE("Planes on stairs: at 10 cm cells each tread is its own step patch, no
   constexpr double kOffGrid = 0.08;  // the first riser's foot, m
   for (const unsigned seed : {1U, 2U}) {
     CAPTURE(seed);
-    test::PlaneSceneBuilder scene(0.1, 0.01, seed);
-    scene.withNoise(0.01, kFileVariance).floor(-1.5, 0.0, kOffGrid, 2.0, 0.0);
-    for (int step = 0; step <= kFiveTreads; ++step) {
-      const double foot = kOffGrid + step * (kEdge + kTread);
-      scene.rectangle({foot, 0.0, step * kRiser}, {kEdge, 0.0, kRiser}, {0.0, 2.0, 0.0}, 0.02);
-      const double depth = step < kFiveTreads ? kTread : 1.5;
-      scene.floor(foot + kEdge, 0.0, foot + kEdge + depth, 2.0, (step + 1) * kRiser);
-    }
+    test::PlaneSceneBuilder scene =
+        elevationStairs(Staircase{.cell = 0.1, .noise = 0.01, .start = kOffGrid, .treads = kFiveTreads}, seed);
     const PlaneDetection detection = detectPlanes(scene.map());
     for (int step = 1; step <= kFiveTreads; ++step) {
       CAPTURE(step);
-      const double height = step * kRiser;
-      const Plane* tread = nullptr;
-      for (const Plane& plane : detection.planes) {
-        if (std::abs(plane.centroid.z() - height) > 0.04) continue;
-        if (tread == nullptr || plane.area > tread->area) tread = &plane;
-      }
+      const Plane* tread = largestAt(detection, step * kRiser);
       REQUIRE(tread != nullptr);
       // Within 8° of level (its edge blocks lean it 6-7°), most of its 0.52 m² and no
       // neighbour's.
@@ -106,10 +113,6 @@ TEST_CASE("Planes on stairs: at 10 cm cells each tread is its own step patch, no
       CHECK(tread->area > 0.35);
       CHECK(tread->area < 0.7);
     }
-    for (const Plane& plane : detection.planes) {
-      CAPTURE(plane.normal.transpose());
-      CAPTURE(plane.centroid.transpose());
-      if (plane.area > 0.2) CHECK((tiltDeg(plane.normal) < 8.0 || tiltDeg(plane.normal) > 60.0));
-    }
+    checkNoRamp(detection);
   }
 }
