@@ -44,3 +44,30 @@ TEST_CASE("Classes: a floor 2° off level, seen in two patches apart, is floor i
   CHECK(planes[2].label == PlaneClass::Ceiling);
   CHECK(planes[3].label == PlaneClass::Table);
 }
+
+TEST_CASE("Classes: a level patch with the map's surface under it is no floor (a cloud cut above its floor)") {
+  // Bobkov's room 2 is cut at z 1.5, above its floor: the lowest level patches are chair
+  // seats 0.4 m higher, with their legs and the walls' feet below them.
+  const Eigen::Vector3d up(0.0, 0.0, 1.0);
+  std::vector<Plane> planes;
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.45}, 0.0, 2.0, 0.0, 2.0));  // seats
+  planes.push_back(levelPatch(up, {0.0, 0.0, 1.2}, 2.5, 3.5, 0.0, 1.0));   // a table
+  std::vector<SurfaceSample> surface;
+  for (int k = 0; k < 100; ++k) surface.push_back({Eigen::Vector3d(0.03 * k, 0.5, 0.1), 1.0});  // legs, wall feet
+  for (int k = 0; k < 300; ++k) surface.push_back({Eigen::Vector3d(0.01 * k, 0.5, 0.45), 1.0});
+  std::vector<Plane> seen = planes;
+  classifyPlanes(seen, {}, surface);
+  CHECK(seen[0].label != PlaneClass::Floor);  // floor without the surface samples
+  CHECK(seen[1].label != PlaneClass::Table);
+
+  // A real floor with a few stray readings under it (reflections: at most 0.13 % of the
+  // points of seven real scans) stays floor.
+  std::vector<SurfaceSample> floor_surface(1000, SurfaceSample{Eigen::Vector3d(0.5, 0.5, 0.45), 1.0});
+  floor_surface.push_back({Eigen::Vector3d(0.5, 0.5, -0.5), 5.0});
+  seen = planes;
+  classifyPlanes(seen, {}, floor_surface);
+  CHECK(seen[0].label == PlaneClass::Floor);
+  CHECK(seen[1].label == PlaneClass::Table);
+  classifyPlanes(planes);
+  CHECK(planes[0].label == PlaneClass::Floor);  // without samples, as before
+}

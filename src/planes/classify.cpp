@@ -42,7 +42,7 @@ std::string_view className(PlaneClass plane_class) {
   return "other";
 }
 
-void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config) {
+void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, std::span<const SurfaceSample> surface) {
   const double cos_horizontal = std::cos(config.horizontal_deg * std::numbers::pi / 180.0);
   const double sin_vertical = std::sin(config.horizontal_deg * std::numbers::pi / 180.0);
   std::vector<std::size_t> horizontal;
@@ -64,6 +64,14 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config) {
     if (planes[k].centroid.z() <= lowest + config.floor_search && (floor == nullptr || planes[k].area > floor->area)) {
       floor = &planes[k];
     }
+  }
+  if (floor != nullptr && !surface.empty()) {
+    double below = 0.0, total = 0.0;
+    for (const SurfaceSample& sample : surface) {
+      total += sample.weight;
+      if (floor->normal.dot(sample.point) + floor->offset < -config.riser_max) below += sample.weight;
+    }
+    if (below > config.floor_max_share_below * total) floor = nullptr;
   }
   // m: how far `point` lies above the floor's plane (horizontal normals point up).
   auto aboveFloor = [&](const Eigen::Vector3d& point) { return floor->normal.dot(point) + floor->offset; };

@@ -192,7 +192,20 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   stats.stages.index = stage();
   PatchSet patches = detector.run(stats);
   stage();
-  classifyPlanes(patches.planes);
+  // The map's surface, each block's bottom weighted by its points: whether anything lies
+  // under the lowest level patch.
+  std::vector<SurfaceSample> bottoms;
+  bottoms.reserve(grid.size());
+  for (std::size_t cell = 0; cell < grid.cellCount(); ++cell) {
+    const auto blocks = map.blocksAt(grid.mapCellOf(cell));
+    for (std::uint32_t id = grid.firstBlockOfCell(cell); id < grid.firstBlockOfCell(cell + 1); ++id) {
+      const PlaneBlock& block = grid.blocks()[id];
+      for (std::size_t k = block.map_first; k < block.map_first + block.map_count; ++k)
+        bottoms.push_back({Eigen::Vector3d(block.point.x(), block.point.y(), blocks[k].bottom()),
+                           std::max<double>(1.0, blocks[k].points.count)});
+    }
+  }
+  classifyPlanes(patches.planes, {}, bottoms);
   mergeLevels(grid, patches, radians(config.kappa_deg), sheets ? config.noise : 0.0);
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));  // the merged levels'
   stats.stages.merges += stage();
