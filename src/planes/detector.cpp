@@ -8,6 +8,7 @@
 #include "mlmap/planes/classify.hpp"
 #include "mlmap/planes/patches.hpp"
 #include "patch_rules.hpp"
+#include "seen_gaps.hpp"
 #include "sheets.hpp"
 #include "unseen_gaps.hpp"
 
@@ -189,6 +190,8 @@ SplitPatches Detector::splitSheets(const std::vector<std::uint32_t>& matching, c
     }
     split = std::move(sorted);
   }
+  // Level pieces a gap apart that the scanner saw past are two surfaces.
+  splitAtSeenGaps(grid_, split.patches, split.outline_runs, normal, point, band);
   // A wall's pieces are joined across unseen gaps along it, whichever sheet each came
   // from, where their mean distances from the plane lie within the step (one face).
   const std::size_t count = split.patches.size();

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "median.hpp"
+#include "seen_gaps.hpp"
 
 namespace mlmap {
 namespace {
@@ -145,18 +146,34 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
       const bool a_smaller = set.blocks[a].size() <= set.blocks[b].size();
       const auto& walked = set.blocks[a_smaller ? a : b];
       const std::int32_t wanted = (a_smaller ? second : first).id;
+      // Level pieces near but not cell to cell are one surface where mostly nothing was
+      // seen between them (an occluder's shadow), two where the scanner saw past them.
+      const bool both_level = level(first) && level(second);
+      const bool from_above = both_level && seenFromAbove(grid, set.blocks[a_smaller ? b : a], larger.normal,
+                                                          larger.centroid, epsilon);
       bool touching = false;
+      std::size_t clear = 0, through = 0;
       for (const std::uint32_t id : walked) {
-        grid.forEachNeighbour(grid.blocks()[id].cell, touch_radius, [&](std::uint32_t other) {
-          if (set.labels[other] == wanted) touching = true;
+        const CellIndex cell = grid.blocks()[id].cell;
+        grid.forEachNeighbour(cell, touch_radius, [&](std::uint32_t other) {
+          if (set.labels[other] != wanted || touching) return;
+          const CellIndex near = grid.blocks()[other].cell;
+          if (!from_above || std::max(std::abs(near.i - cell.i), std::abs(near.j - cell.j)) <= 1) {
+            touching = true;
+          } else if (seenPast(grid, larger.normal, larger.centroid, cell, near, epsilon)) {
+            ++through;
+          } else {
+            ++clear;
+          }
         });
         if (touching) break;
       }
+      touching = touching || (clear > 0 && clear >= through);
       // Level pieces that meet cell to cell meet at one height: stair treads, each
       // fitted leaning towards its risers, pass the tests above at 10 cm cells (plane_seg's
       // ANYmal stairs: 8-19° off level) and chained into one ramp, though where they meet
       // their blocks differ by a riser (16.5 cm).
-      if (touching && level(first) && level(second)) {
+      if (touching && both_level) {
         std::vector<float> seam;
         for (const std::uint32_t id : walked) {
           const PlaneBlock& block = grid.blocks()[id];

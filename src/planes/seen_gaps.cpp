@@ -1,0 +1,136 @@
+#include "seen_gaps.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <unordered_map>
+
+namespace mlmap {
+namespace {
+
+std::int64_t keyOf(CellIndex cell) {
+  return (static_cast<std::int64_t>(cell.i) << 32) ^ static_cast<std::uint32_t>(cell.j);
+}
+
+int chebyshev(CellIndex a, CellIndex b) { return std::max(std::abs(a.i - b.i), std::abs(a.j - b.j)); }
+
+}  // namespace
+
+bool seenPast(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eigen::Vector3d& point, CellIndex from,
+              CellIndex to, double tolerance) {
+  const int steps = chebyshev(from, to);
+  for (int step = 1; step < steps; ++step) {
+    const double t = static_cast<double>(step) / steps;
+    const auto i = static_cast<std::int32_t>(std::lround(from.i + t * (to.i - from.i)));
+    const auto j = static_cast<std::int32_t>(std::lround(from.j + t * (to.j - from.j)));
+    const Eigen::Vector2d centre = grid.cellCentre(CellIndex{i, j});
+    const double height =
+        point.z() - (normal.x() * (centre.x() - point.x()) + normal.y() * (centre.y() - point.y())) / normal.z();
+    bool below = false, at = false;
+    grid.forEachInCells(i, i, j, j, [&](std::uint32_t id) {
+      const PlaneBlock& block = grid.blocks()[id];
+      if (block.top < height - tolerance) {
+        below = true;
+      } else if (block.bottom <= height + tolerance) {
+        at = true;
+      }
+    });
+    if (below && !at) return true;
+  }
+  return false;
+}
+
+bool seenFromAbove(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
+                   const Eigen::Vector3d& point, double tolerance) {
+  std::size_t covered = 0;
+  for (const std::uint32_t id : blocks) {
+    const CellIndex cell = grid.blocks()[id].cell;
+    const Eigen::Vector2d centre = grid.cellCentre(cell);
+    const double height =
+        point.z() - (normal.x() * (centre.x() - point.x()) + normal.y() * (centre.y() - point.y())) / normal.z();
+    bool above = false;
+    grid.forEachInCells(cell.i, cell.i, cell.j, cell.j,
+                        [&](std::uint32_t other) { above = above || grid.blocks()[other].bottom > height + tolerance; });
+    covered += above ? 1 : 0;
+  }
+  return 2 * covered > blocks.size();
+}
+
+void splitAtSeenGaps(const BlockGrid& grid, std::vector<Patch>& patches, std::vector<std::vector<Segment>>& outline_runs,
+                     const Eigen::Vector3d& normal, const Eigen::Vector3d& point, double tolerance) {
+  if (std::abs(normal.z()) < std::cos(std::acos(-1.0) / 4.0)) return;
+  std::vector<Patch> result;
+  std::vector<std::vector<Segment>> result_runs;
+  bool cut = false;
+  for (std::size_t k = 0; k < patches.size(); ++k) {
+    const std::vector<std::uint32_t>& blocks = patches[k].blocks;
+    if (!seenFromAbove(grid, blocks, normal, point, tolerance)) {
+      result.push_back(std::move(patches[k]));
+      result_runs.push_back(std::move(outline_runs[k]));
+      continue;
+    }
+    std::unordered_map<std::int64_t, std::vector<std::uint32_t>> at_cell;  // positions in `blocks`
+    for (std::uint32_t n = 0; n < blocks.size(); ++n) at_cell[keyOf(grid.blocks()[blocks[n]].cell)].push_back(n);
+    std::vector<std::uint32_t> parent(blocks.size());
+    std::iota(parent.begin(), parent.end(), 0U);
+    const auto root = [&](std::uint32_t n) {
+      while (parent[n] != n) n = parent[n] = parent[parent[n]];
+      return n;
+    };
+    // Cell to cell first: the gaps are judged between the pieces that result.
+    for (const int reach : {1, 2}) {
+      for (std::uint32_t n = 0; n < blocks.size(); ++n) {
+        const CellIndex cell = grid.blocks()[blocks[n]].cell;
+        for (int di = -reach; di <= reach; ++di) {
+          for (int dj = -reach; dj <= reach; ++dj) {
+            const CellIndex near{cell.i + di, cell.j + dj};
+            if (chebyshev(cell, near) != reach) continue;
+            const auto found = at_cell.find(keyOf(near));
+            if (found == at_cell.end()) continue;
+            for (const std::uint32_t m : found->second) {
+              if (root(m) == root(n)) continue;
+              if (reach == 1 || !seenPast(grid, normal, point, cell, near, tolerance)) parent[root(m)] = root(n);
+            }
+          }
+        }
+      }
+    }
+    std::unordered_map<std::uint32_t, std::size_t> piece_of_root;
+    std::vector<Patch> pieces;
+    for (std::uint32_t n = 0; n < blocks.size(); ++n) {
+      const auto [slot, added] = piece_of_root.try_emplace(root(n), pieces.size());
+      if (added) pieces.emplace_back();
+      Patch& piece = pieces[slot->second];
+      piece.blocks.push_back(blocks[n]);  // ascending, as the patch's
+      piece.surface += grid.blocks()[blocks[n]].surface;
+    }
+    if (pieces.size() <= 1) {
+      result.push_back(std::move(patches[k]));
+      result_runs.push_back(std::move(outline_runs[k]));
+      continue;
+    }
+    cut = true;
+    for (Patch& piece : pieces) {
+      result.push_back(std::move(piece));
+      result_runs.emplace_back();
+    }
+  }
+  if (!cut) {  // as they were, in their order
+    patches = std::move(result);
+    outline_runs = std::move(result_runs);
+    return;
+  }
+  std::vector<std::size_t> order(result.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return result[a].surface > result[b].surface; });
+  patches.clear();
+  outline_runs.clear();
+  for (const std::size_t k : order) {
+    patches.push_back(std::move(result[k]));
+    outline_runs.push_back(std::move(result_runs[k]));
+  }
+}
+
+}  // namespace mlmap

@@ -1,0 +1,70 @@
+// Level surfaces apart (issue 19: "two separate tables ... form one patch"): the patch
+// split connects blocks across a one-cell gap, and the coplanar merge pieces within
+// 0.3 m, so two desks a hand apart at one height were one table. Where the floor shows
+// between them they are two; a desk whose middle nobody saw (a monitor's shadow) is one.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "mlmap/planes/ermsm.hpp"
+#include "plane_scenes.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+// The level patches whose centroid lies within 3 cm of `height`, largest first.
+std::vector<const Plane*> levelAt(const PlaneDetection& detection, double height) {
+  std::vector<const Plane*> found;
+  for (const Plane& plane : detection.planes) {
+    if (std::abs(plane.normal.z()) > 0.95 && std::abs(plane.centroid.z() - height) < 0.03) found.push_back(&plane);
+  }
+  std::sort(found.begin(), found.end(), [](const Plane* a, const Plane* b) { return a->area > b->area; });
+  return found;
+}
+
+}  // namespace
+
+TEST_CASE("eRMSM: two desks 0.25 m apart at one height, the floor seen between them, are two patches") {
+  for (const double cell : {0.05, 0.1}) {
+    for (const unsigned seed : {1U, 2U}) {
+      CAPTURE(cell);
+      CAPTURE(seed);
+      test::PlaneSceneBuilder scene(cell, 0.01, seed);
+      // Offsets of a third of a cell: the gap does not fall on cell boundaries.
+      const double o = cell / 3.0;
+      scene.withNoise(0.01, 9e-4)
+          .floor(o, o, 5.0 + o, 4.0 + o, 0.0)
+          .floor(o, o, 5.0 + o, 4.0 + o, 2.6)  // the ceiling over them
+          .floor(1.0 + o, 1.0 + o, 2.4 + o, 1.75 + o, 0.75)
+          .floor(2.65 + o, 1.0 + o, 4.05 + o, 1.75 + o, 0.75);
+      const PlaneDetection detection = detectPlanes(scene.map());
+      const std::vector<const Plane*> desks = levelAt(detection, 0.75);
+      REQUIRE(desks.size() >= 2);
+      // Each about its own 1.05 m², not the two together.
+      CHECK(desks[0]->area < 1.5);
+      CHECK(desks[1]->area > 0.8);
+    }
+  }
+}
+
+TEST_CASE("eRMSM: a desk whose middle strip nobody saw is one patch") {
+  for (const double cell : {0.05, 0.1}) {
+    CAPTURE(cell);
+    test::PlaneSceneBuilder scene(cell, 0.01, 1);
+    const double o = cell / 3.0;
+    // The desk's two halves 0.2 m apart with nothing seen between them: no floor under
+    // the desk (it hides it), none of the strip.
+    scene.withNoise(0.01, 9e-4)
+        .floor(o, o, 5.0 + o, 1.0 + o, 0.0)
+        .floor(o, 1.75 + o, 5.0 + o, 4.0 + o, 0.0)
+        .floor(o, o, 5.0 + o, 4.0 + o, 2.6)
+        .floor(1.0 + o, 1.0 + o, 2.0 + o, 1.75 + o, 0.75)
+        .floor(2.2 + o, 1.0 + o, 3.2 + o, 1.75 + o, 0.75);
+    const PlaneDetection detection = detectPlanes(scene.map());
+    const std::vector<const Plane*> desks = levelAt(detection, 0.75);
+    REQUIRE(!desks.empty());
+    CHECK(desks[0]->area > 1.3);  // both halves, 1.5 m² (and their edge cells)
+  }
+}
