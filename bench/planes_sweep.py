@@ -62,6 +62,8 @@ CONDITIONS = {
     "noise3": {"range_sigma": 0.03},
     "lines2": {"tilt_step_x": 2},  # the scene's own tilt step doubled
     "sparse": {"tilt_step_deg": 2.0, "angular_step_deg": 0.5},
+    "rings16": {"field_of_view_deg": 360, "tilt_start_deg": -15.0, "tilt_end_deg": 15.0, "tilt_step_deg": 2.0,
+                "angular_step_deg": 0.2},
     "yup": {},
     "odom": {},
 }

@@ -46,7 +46,11 @@ struct BeamOrigins {
 // patches it lies on (within tolerance of the plane) among its block's and those of
 // the blocks of its own and the 8 neighbouring cells that reach its height, or none (0)
 // if it lies on none. Nearest: along the point's beam when `beams` are given (range
-// noise lies along the beam), else in units of each plane's tolerance.
+// noise lies along the beam), else in units of each plane's tolerance. With beams, where
+// two surfaces meet at an edge the point takes the one its beam met first (a concave
+// edge: the floor at a cabinet's foot) or last (a convex one: a desk's top at its front),
+// each only where its patch is, and a plane the beam meets further off than that patch's
+// range noise reaches is no candidate beside one it meets within it.
 // `labels` are labelPoints' (any value ≤ 0 is "none"); `points` are world points.
 // Returns the refitted planes in id order (ids ≤ 0 and repeats left out). Deterministic
 // at any thread count.

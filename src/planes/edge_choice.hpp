@@ -1,0 +1,96 @@
+// Internal to point labelling: which of the patches near a point it was measured on,
+// where two surfaces meet at an edge (a cabinet on the floor, a desk's top and front).
+// Within the planes' tolerances of the edge a point lies on both; the distances alone
+// decide by the range noise, the beam decides by geometry.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "mlmap/planes/point_labels.hpp"
+
+namespace mlmap {
+
+struct Candidate {
+  std::uint32_t slot;
+  double rank;   // the distance the choice among parallel planes goes by
+  double meets;  // m along the beam from the point to where it meets the plane
+};
+
+// A point near a corner of three patches lies on all of them.
+constexpr std::size_t kMaxCandidates = 8;
+
+// Beams this close to grazing a plane rank as if at this cosine (about 87°).
+constexpr double kMinIncidenceCosine = 0.05;
+
+// Planes closer in direction than this are layers of one surface (or parallel ones),
+// not two surfaces meeting at an edge: the detector's κ (25°).
+constexpr double kEdgeCosine = 0.9063;
+
+// How far along their beams each patch's own points lie from its plane: the range noise
+// as that surface saw it (the planes' σ is across them, a fraction of it on a floor or
+// a table seen at a grazing angle). `sigmas` times its robust estimate (the median
+// offset), at least the plane's tolerance; infinite for a patch of fewer than 3 points.
+// `beam_of(index)`: the unit beam of a point (zero where unknown).
+std::vector<double> alongTolerances(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
+                                    const std::vector<PointPlane>& fitted,
+                                    const std::function<Eigen::Vector3d(std::size_t)>& beam_of, double sigmas);
+
+struct HeightRange {  // m; empty (low > high) where unknown
+  float low = INFINITY;
+  float high = -INFINITY;
+};
+
+// How high each patch reaches, from the points that lie on it alone (`sole`: the patch
+// slot of each point on one patch, else 0): the height bins in which its points spread
+// at least `min_width` along it, widened by a bin and two tolerances (the band where it
+// meets another surface holds none of its own points). Not the points' extremes: a
+// wall's points up the line where a cabinet's side meets it can lie on the side's plane
+// alone, a thin trail above the cabinet's top; and the foot of a wall behind furniture is
+// seen in few places, but those are wide.
+std::vector<HeightRange> patchHeights(std::span<const Point> points, std::span<const std::uint32_t> sole,
+                                      const std::vector<PointPlane>& fitted, double min_width);
+
+// The candidate the point was measured on (0: none). Between two surfaces that meet at
+// an edge, its beam tells: both planes see the point's range error alike, and the true
+// surface is the one the beam met, which is where the other plane is hidden (a concave
+// edge, a cabinet standing on the floor: the beam meets the other plane later, behind
+// this surface) or in free air (a convex edge, a desk's top and front: it met the other
+// plane earlier, in front of the edge). Which of the two an edge is the patches say:
+// concave where each lies in front of the other. Only where the beam meets each plane
+// on its patch (`on_patch`). Layers, and points without a beam, go by the smallest rank.
+template <typename OnPatch>
+std::uint32_t likeliest(std::span<const Candidate> candidates, const std::vector<PointPlane>& fitted,
+                        const std::vector<Eigen::Vector3d>& centroid, const Eigen::Vector3d& beam, OnPatch&& on_patch) {
+  if (candidates.empty()) return 0;
+  const Candidate* best = &candidates[0];
+  for (const Candidate& c : candidates)
+    if (c.rank < best->rank) best = &c;
+  if (beam.isZero()) return best->slot;
+  const auto facing = [&](std::uint32_t slot) {  // the normal towards the scanner
+    const Eigen::Vector3d& n = fitted[slot].normal;
+    return n.dot(beam) < 0.0 ? n : Eigen::Vector3d(-n);
+  };
+  for (const Candidate& c : candidates) {
+    if (&c == best || std::abs(fitted[c.slot].normal.dot(fitted[best->slot].normal)) >= kEdgeCosine) continue;
+    // A plane counts where its patch is: past a cabinet's top its side's plane is air.
+    const bool here = on_patch(*best), there = on_patch(c);
+    if (here != there) {
+      if (there) best = &c;
+      continue;
+    }
+    if (!here) continue;
+    const double ahead = facing(best->slot).dot(centroid[c.slot] - centroid[best->slot]);
+    const double behind = facing(c.slot).dot(centroid[best->slot] - centroid[c.slot]);
+    const bool concave = ahead > 0.0 && behind > 0.0;
+    const bool convex = ahead < 0.0 && behind < 0.0;
+    if ((concave && c.meets < best->meets) || (convex && c.meets > best->meets)) best = &c;
+  }
+  return best->slot;
+}
+
+}  // namespace mlmap
