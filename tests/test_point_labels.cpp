@@ -117,6 +117,27 @@ TEST_CASE("Point labels: a point on no patch's plane gets none, and a point besi
   CHECK(labels[2] == -1);
 }
 
+TEST_CASE("Point labels: non-finite points beside a patch's points get none, with beams too") {
+  Corner corner;
+  std::vector<Point> points = corner.scan.points;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  points.emplace_back(1.0, 1.0, nan);
+  points.emplace_back(nan, 1.0, 0.0);
+  points.emplace_back(1.0, 1.0, inf);
+  Scan all;
+  all.points = points;
+  std::vector<std::int32_t> labels = labelPoints(corner.map, all);
+  // As if their blocks had collected them: the refinement must not trust that.
+  for (std::size_t k = points.size() - 3; k < points.size(); ++k) labels[k] = corner.floor_id;
+  const std::vector<Point> origins{Point(1.0, 1.0, 1.2)};
+  const std::vector<std::uint32_t> origin_of_point(points.size(), 0);
+  refinePointLabels(corner.map, corner.detection.planes, points, labels, corner.options(),
+                    BeamOrigins{origins, origin_of_point});
+  for (std::size_t k = points.size() - 3; k < points.size(); ++k) CHECK(labels[k] <= 0);
+  CHECK(std::count(labels.begin(), labels.end(), corner.floor_id) > 30000);
+}
+
 TEST_CASE("Point labels: patch ids the plane list does not know, and a hostile plane list, give none") {
   Corner corner;
   const Scan& scan = corner.scan;

@@ -1,6 +1,7 @@
 #include "edge_choice.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace mlmap {
@@ -8,6 +9,9 @@ namespace {
 
 // A patch's heights in bins of this (or its tolerance).
 constexpr double kHeightBin = 0.02;
+
+// Height bins of one patch at most (2 km at 2 cm).
+constexpr double kMaxHeightBins = 1e5;
 
 // σ of a normal distribution from the median of its absolute values.
 constexpr double kMadToSigma = 1.4826;
@@ -26,7 +30,7 @@ std::vector<double> alongTolerances(std::span<const Point> points, std::span<con
     const PointPlane& plane = fitted[slot];
     const double signed_distance = plane.normal.dot(points[index]) + plane.offset;
     const double along = plane.normal.dot(beam_of(index));
-    if (std::abs(signed_distance) > plane.tolerance || std::abs(along) < kMinIncidenceCosine) continue;
+    if (!(std::abs(signed_distance) <= plane.tolerance) || !(std::abs(along) >= kMinIncidenceCosine)) continue;
     offsets[slot].push_back(static_cast<float>(std::abs(signed_distance / along)));
   }
   for (std::size_t slot = 1; slot < slots; ++slot) {
@@ -53,12 +57,16 @@ std::vector<HeightRange> patchHeights(std::span<const Point> points, std::span<c
     if (horizontal.norm() > 0.1) across[slot] = horizontal.normalized();
   }
   for (std::size_t index = 0; index < points.size(); ++index)
-    if (sole[index] != 0) base[sole[index]] = std::min(base[sole[index]], static_cast<float>(points[index].z()));
+    if (sole[index] != 0 && std::isfinite(points[index].z()))
+      base[sole[index]] = std::min(base[sole[index]], static_cast<float>(points[index].z()));
   const auto binWidth = [&](std::size_t slot) { return std::max(kHeightBin, fitted[slot].tolerance); };
   for (std::size_t index = 0; index < points.size(); ++index) {
     const std::uint32_t slot = sole[index];
     if (slot == 0) continue;
-    const auto n = static_cast<std::size_t>((points[index].z() - base[slot]) / binWidth(slot));
+    const double offset = (points[index].z() - base[slot]) / binWidth(slot);
+    // A patch's own points lie within its blocks' heights: more bins than this are no patch.
+    if (!(offset >= 0.0 && offset < kMaxHeightBins)) continue;
+    const auto n = static_cast<std::size_t>(offset);
     if (n >= bins[slot].size()) bins[slot].resize(n + 1);
     const auto u = static_cast<float>(across[slot].dot(points[index]));
     bins[slot][n].low = std::min(bins[slot][n].low, u);

@@ -170,6 +170,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   const auto gather = [&](std::size_t index, const Eigen::Vector3d& beam, std::array<Candidate, kMaxCandidates>& out) {
     const Point& p = points[index];
     std::size_t found = 0;
+    if (!p.allFinite()) return found;
     const auto consider = [&](std::uint32_t slot) {
       const PointPlane& plane = fitted[slot];
       const double signed_distance = plane.normal.dot(p) + plane.offset;
