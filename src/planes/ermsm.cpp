@@ -15,6 +15,7 @@
 #include "mlmap/planes/direction_vectors.hpp"
 #include "patch_merges.hpp"
 #include "patch_set.hpp"
+#include "bevels.hpp"
 #include "surface_noise.hpp"
 
 namespace mlmap {
@@ -192,6 +193,7 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   stats.stages.index = stage();
   PatchSet patches = detector.run(stats);
   stage();
+  dropBevels(grid, patches, config.epsilon, radians(config.kappa_deg));
   // The map's surface, each block's bottom weighted by its points: whether anything lies
   // under the lowest level patch.
   std::vector<SurfaceSample> bottoms;

@@ -1,0 +1,103 @@
+#include "bevels.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+namespace mlmap {
+namespace {
+
+double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(std::abs(a.dot(b)), 0.0, 1.0));
+}
+
+// Patches touch within this many cells: blocks at an edge take directions between the two
+// surfaces', so neither surface's patch may reach the edge's own column.
+constexpr int kTouchCells = 2;
+// A strip along an edge: at least this share of its blocks touch each of the two surfaces.
+constexpr double kTouchingShare = 0.5;
+// A piece across a corner: at least this share of its blocks lie on one of the two.
+constexpr double kOnNeighboursShare = 0.8;
+// Its normal lies between theirs: its angles to the two add up to theirs, within this.
+constexpr double kBetweenSlack = 10.0 * std::numbers::pi / 180.0;
+
+}  // namespace
+
+void dropBevels(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad) {
+  const std::size_t count = set.planes.size();
+  std::vector<bool> drop(count, false);
+  std::vector<double> surface(count, 0.0);
+  for (std::size_t k = 0; k < count; ++k)
+    for (const std::uint32_t id : set.blocks[k]) surface[k] += grid.blocks()[id].surface;
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::vector<std::uint32_t>& blocks = set.blocks[k];
+    if (blocks.empty()) continue;
+    // Per neighbouring patch, how many of this patch's blocks touch it.
+    std::map<std::int32_t, std::size_t> touching;
+    for (const std::uint32_t id : blocks) {
+      std::vector<std::int32_t> seen;
+      grid.forEachNeighbour(grid.blocks()[id].cell, kTouchCells, [&](std::uint32_t other) {
+        const std::int32_t label = set.labels[other];
+        if (label > 0 && static_cast<std::size_t>(label) != k + 1 &&
+            std::find(seen.begin(), seen.end(), label) == seen.end())
+          seen.push_back(label);
+      });
+      for (const std::int32_t label : seen) ++touching[label];
+    }
+    const Eigen::Vector3d& normal = set.planes[k].normal;
+    // Larger patches it touches (in surface: a wall's column is one block), at least κ/2
+    // from it in direction.
+    std::vector<std::pair<std::size_t, std::size_t>> sides;  // (patch, blocks touching it)
+    for (const auto& [label, blocks_touching] : touching) {
+      const auto other = static_cast<std::size_t>(label - 1);
+      if (surface[other] > surface[k] && angleBetween(normal, set.planes[other].normal) >= 0.5 * kappa_rad)
+        sides.emplace_back(other, blocks_touching);
+    }
+    // The share of its blocks lying on one of two planes (within ε): a piece across a
+    // corner is made of the two walls' blocks; a surface of its own across the corner (a
+    // corner cabinet's front) lies off both.
+    const auto onEither = [&](const Plane& first, const Plane& second) {
+      std::size_t on = 0;
+      for (const std::uint32_t id : blocks) {
+        const Eigen::Vector3d point = grid.blocks()[id].point.cast<double>();
+        const double a = std::abs(first.normal.dot(point) + first.offset);
+        const double b = std::abs(second.normal.dot(point) + second.offset);
+        on += std::min(a, b) <= epsilon ? 1 : 0;
+      }
+      return static_cast<double>(on) / static_cast<double>(blocks.size());
+    };
+    for (std::size_t a = 0; a < sides.size() && !drop[k]; ++a) {
+      for (std::size_t b = a + 1; b < sides.size() && !drop[k]; ++b) {
+        const Plane& first = set.planes[sides[a].first];
+        const Plane& second = set.planes[sides[b].first];
+        const double apart = angleBetween(first.normal, second.normal);
+        if (apart < std::numbers::pi / 4.0 ||
+            angleBetween(normal, first.normal) + angleBetween(normal, second.normal) > apart + kBetweenSlack)
+          continue;
+        const double share = kTouchingShare * static_cast<double>(blocks.size());
+        const bool strip = static_cast<double>(sides[a].second) >= share && static_cast<double>(sides[b].second) >= share;
+        drop[k] = strip || onEither(first, second) >= kOnNeighboursShare;
+      }
+    }
+  }
+  if (std::none_of(drop.begin(), drop.end(), [](bool d) { return d; })) return;
+  std::vector<std::int32_t> new_id(count, 0);
+  PatchSet kept;
+  kept.labels = std::move(set.labels);
+  for (std::size_t k = 0; k < count; ++k) {
+    if (drop[k]) continue;
+    Plane plane = std::move(set.planes[k]);
+    plane.id = static_cast<std::int32_t>(kept.planes.size() + 1);
+    new_id[k] = plane.id;
+    kept.planes.push_back(std::move(plane));
+    kept.blocks.push_back(std::move(set.blocks[k]));
+    kept.outline_frames.push_back(set.outline_frames[k]);
+    kept.outline_runs.push_back(std::move(set.outline_runs[k]));
+  }
+  for (std::int32_t& label : kept.labels)
+    if (label > 0) label = new_id[static_cast<std::size_t>(label - 1)];
+  set = std::move(kept);
+}
+
+}  // namespace mlmap
