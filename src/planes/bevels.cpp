@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <map>
 #include <numbers>
 
@@ -15,6 +17,8 @@ double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 // Patches touch within this many cells: blocks at an edge take directions between the two
 // surfaces', so neither surface's patch may reach the edge's own column.
 constexpr int kTouchCells = 2;
+// The sides considered: this many largest patches.
+constexpr std::size_t kLargestSides = 32;
 // A strip along an edge: at least this share of its blocks touch each of the two surfaces.
 constexpr double kTouchingShare = 0.5;
 // A piece across a corner: at least this share of its blocks lie on one of the two.
@@ -30,9 +34,32 @@ void dropBevels(const BlockGrid& grid, PatchSet& set, double epsilon, double kap
   std::vector<double> surface(count, 0.0);
   for (std::size_t k = 0; k < count; ++k)
     for (const std::uint32_t id : set.blocks[k]) surface[k] += grid.blocks()[id].surface;
+  // A bevel has two larger neighbours: the two largest patches are none (nor walked, the
+  // floor and the ceiling of a fine map: hundreds of thousands of blocks).
+  std::vector<double> sorted = surface;
+  std::sort(sorted.begin(), sorted.end(), std::greater<>());
+  const double second = sorted.size() >= 2 ? sorted[1] : std::numeric_limits<double>::infinity();
+  // The largest patches by surface: the sides a bevel can have (before the walk that
+  // finds which it touches, whether any two of them could hold it between them).
+  std::vector<std::size_t> by_surface(count);
+  for (std::size_t k = 0; k < count; ++k) by_surface[k] = k;
+  std::sort(by_surface.begin(), by_surface.end(), [&](std::size_t a, std::size_t b) { return surface[a] > surface[b]; });
+  by_surface.resize(std::min(count, kLargestSides));
+  const auto between = [&](const Eigen::Vector3d& normal, const Eigen::Vector3d& first, const Eigen::Vector3d& second) {
+    const double apart = angleBetween(first, second);
+    return apart >= std::numbers::pi / 4.0 && angleBetween(normal, first) >= 0.5 * kappa_rad &&
+           angleBetween(normal, second) >= 0.5 * kappa_rad &&
+           angleBetween(normal, first) + angleBetween(normal, second) <= apart + kBetweenSlack;
+  };
   for (std::size_t k = 0; k < count; ++k) {
     const std::vector<std::uint32_t>& blocks = set.blocks[k];
-    if (blocks.empty()) continue;
+    if (blocks.empty() || surface[k] >= second) continue;
+    bool possible = false;
+    for (std::size_t a = 0; a < by_surface.size() && !possible; ++a)
+      for (std::size_t b = a + 1; b < by_surface.size() && !possible; ++b)
+        possible = surface[by_surface[b]] > surface[k] &&
+                   between(set.planes[k].normal, set.planes[by_surface[a]].normal, set.planes[by_surface[b]].normal);
+    if (!possible) continue;
     // Per neighbouring patch, how many of this patch's blocks touch it.
     std::map<std::int32_t, std::size_t> touching;
     for (const std::uint32_t id : blocks) {

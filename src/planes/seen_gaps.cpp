@@ -41,20 +41,38 @@ bool seenPast(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eigen:
   return false;
 }
 
-bool seenFromAbove(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
-                   const Eigen::Vector3d& point, double tolerance) {
-  std::size_t covered = 0;
+namespace {
+
+// Of the blocks' cells, how many hold map surface above the plane, and how many below.
+struct Beyond {
+  std::size_t above = 0;
+  std::size_t below = 0;
+};
+
+Beyond beyond(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
+              const Eigen::Vector3d& point, double tolerance) {
+  Beyond counts;
   for (const std::uint32_t id : blocks) {
     const CellIndex cell = grid.blocks()[id].cell;
     const Eigen::Vector2d centre = grid.cellCentre(cell);
     const double height =
         point.z() - (normal.x() * (centre.x() - point.x()) + normal.y() * (centre.y() - point.y())) / normal.z();
-    bool above = false;
-    grid.forEachInCells(cell.i, cell.i, cell.j, cell.j,
-                        [&](std::uint32_t other) { above = above || grid.blocks()[other].bottom > height + tolerance; });
-    covered += above ? 1 : 0;
+    bool above = false, below = false;
+    grid.forEachInCells(cell.i, cell.i, cell.j, cell.j, [&](std::uint32_t other) {
+      above = above || grid.blocks()[other].bottom > height + tolerance;
+      below = below || grid.blocks()[other].top < height - tolerance;
+    });
+    counts.above += above ? 1 : 0;
+    counts.below += below ? 1 : 0;
   }
-  return 2 * covered > blocks.size();
+  return counts;
+}
+
+}  // namespace
+
+bool seenFromAbove(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
+                   const Eigen::Vector3d& point, double tolerance) {
+  return 2 * beyond(grid, blocks, normal, point, tolerance).above > blocks.size();
 }
 
 void splitAtSeenGaps(const BlockGrid& grid, std::vector<Patch>& patches, std::vector<std::vector<Segment>>& outline_runs,
@@ -65,7 +83,9 @@ void splitAtSeenGaps(const BlockGrid& grid, std::vector<Patch>& patches, std::ve
   bool cut = false;
   for (std::size_t k = 0; k < patches.size(); ++k) {
     const std::vector<std::uint32_t>& blocks = patches[k].blocks;
-    if (!seenFromAbove(grid, blocks, normal, point, tolerance)) {
+    // Nothing seen under the plane in its own cells (a floor): nothing to see past.
+    const Beyond counts = beyond(grid, blocks, normal, point, tolerance);
+    if (2 * counts.above <= blocks.size() || counts.below == 0) {
       result.push_back(std::move(patches[k]));
       result_runs.push_back(std::move(outline_runs[k]));
       continue;
