@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <functional>
+#include <numbers>
 
 #include "../src/planes/bevels.hpp"
 #include "plane_scenes.hpp"
@@ -65,7 +66,7 @@ TEST_CASE("dropBevels: a strip along the wall's top between wall and ceiling goe
     set.outline_runs.emplace_back();
   }
   const std::size_t front_blocks = set.blocks[4].size();
-  dropBevels(grid, set, 0.05, 25.0 * M_PI / 180.0);
+  dropBevels(grid, set, 0.05, 25.0 * std::numbers::pi / 180.0);
   REQUIRE(set.planes.size() == 4);  // the strip went
   for (std::size_t k = 0; k < set.planes.size(); ++k) {
     CHECK(set.planes[k].id == static_cast<std::int32_t>(k + 1));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <numeric>
 #include <unordered_map>
 
@@ -77,7 +78,7 @@ bool seenFromAbove(const BlockGrid& grid, const std::vector<std::uint32_t>& bloc
 
 void splitAtSeenGaps(const BlockGrid& grid, std::vector<Patch>& patches, std::vector<std::vector<Segment>>& outline_runs,
                      const Eigen::Vector3d& normal, const Eigen::Vector3d& point, double tolerance) {
-  if (std::abs(normal.z()) < std::cos(std::acos(-1.0) / 4.0)) return;
+  if (std::abs(normal.z()) < std::cos(std::numbers::pi / 4.0)) return;
   std::vector<Patch> result;
   std::vector<std::vector<Segment>> result_runs;
   bool cut = false;
