@@ -38,7 +38,7 @@ void dropBevels(const BlockGrid& grid, PatchSet& set, double epsilon, double kap
   // floor and the ceiling of a fine map: hundreds of thousands of blocks).
   std::vector<double> sorted = surface;
   std::sort(sorted.begin(), sorted.end(), std::greater<>());
-  const double second = sorted.size() >= 2 ? sorted[1] : std::numeric_limits<double>::infinity();
+  const double second_largest = sorted.size() >= 2 ? sorted[1] : std::numeric_limits<double>::infinity();
   // The largest patches by surface: the sides a bevel can have (before the walk that
   // finds which it touches, whether any two of them could hold it between them).
   std::vector<std::size_t> by_surface(count);
@@ -53,7 +53,7 @@ void dropBevels(const BlockGrid& grid, PatchSet& set, double epsilon, double kap
   };
   for (std::size_t k = 0; k < count; ++k) {
     const std::vector<std::uint32_t>& blocks = set.blocks[k];
-    if (blocks.empty() || surface[k] >= second) continue;
+    if (blocks.empty() || surface[k] >= second_largest) continue;
     bool possible = false;
     for (std::size_t a = 0; a < by_surface.size() && !possible; ++a)
       for (std::size_t b = a + 1; b < by_surface.size() && !possible; ++b)
