@@ -1,4 +1,6 @@
 // mlmap planes: eRMSM plane detection on a map's blocks; labels, JSON export.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "commands.hpp"
@@ -10,6 +12,9 @@
 
 namespace mlmap::cli {
 namespace {
+
+// A level patch's normal lies within 15° of vertical (ClassifyConfig::horizontal_deg).
+constexpr double kLevelCosine = 0.9659;
 
 struct PlanesArguments {
   std::string map;
@@ -61,6 +66,16 @@ int runPlanes(const PlanesArguments& arguments, bool quiet) {
                 std::string(className(plane.label)).c_str(), plane.area, plane.block_count,
                 100.0 * plane.rms, plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.offset,
                 plane.candidates);
+  }
+  // Classes are heights above the floor: say when there is none to measure from (a cloud
+  // cut above its floor), rather than leave a user to wonder why no table is a table.
+  const bool level = std::any_of(detection.planes.begin(), detection.planes.end(),
+                                 [](const Plane& plane) { return std::abs(plane.normal.z()) >= kLevelCosine; });
+  const bool floor = std::any_of(detection.planes.begin(), detection.planes.end(),
+                                 [](const Plane& plane) { return plane.label == PlaneClass::Floor; });
+  if (!quiet && level && !floor) {
+    std::fprintf(stderr, "note: no floor in view (the map reaches well below its lowest level patch): no patch is "
+                         "classed floor, ceiling or table\n");
   }
   return 0;
 }

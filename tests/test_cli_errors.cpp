@@ -188,6 +188,30 @@ TEST_CASE("CLI: a y-up cloud is warned about, and --up auto or --up y turns it z
   CHECK_FALSE(mlmap::test::contains(result.output, "warning"));
 }
 
+TEST_CASE("CLI: planes says when no floor is in view, and not when one is") {
+  mlmap::test::TempDir dir;
+  // A cloud cut above its floor (as Bobkov's room 2 is): a table top at 0.75 m, its legs'
+  // and a cabinet's lower parts below it, no floor.
+  mlmap::Scan cut;
+  for (double x = 0.0; x <= 1.6; x += 0.01)
+    for (double y = 0.0; y <= 0.8; y += 0.01) cut.points.emplace_back(x, y, 0.75);
+  for (double x = -1.0; x <= 2.5; x += 0.01)
+    for (double z = 0.05; z <= 0.45; z += 0.01) cut.points.emplace_back(x, -0.5, z);
+  for (double y = -0.5; y <= 1.5; y += 0.01)
+    for (double z = 0.05; z <= 0.45; z += 0.01) cut.points.emplace_back(-1.0, y, z);
+  const std::string scan = (dir / "cut.xyz").string(), map = (dir / "cut.mlmap").string();
+  mlmap::io::writeXyz(scan, cut);
+  REQUIRE(runCli("--quiet build --identity --no-octree -o " + map + " " + scan).exit_code == 0);
+  auto result = runCli("planes " + map);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  CHECK(mlmap::test::contains(result.output, "note: no floor in view"));
+  mlmap::io::writeXyz(scan, roomScan(false));
+  REQUIRE(runCli("--quiet build --identity --no-octree -o " + map + " " + scan).exit_code == 0);
+  result = runCli("planes " + map);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  CHECK_FALSE(mlmap::test::contains(result.output, "no floor"));
+}
+
 TEST_CASE("CLI: label and register take --mount as build does") {
   RoomFiles room;
   mlmap::test::writeText(room.dir / "mount.json",
