@@ -2,10 +2,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "commands.hpp"
 #include "mlmap/io/map_file.hpp"
 #include "mlmap/io/planes_json.hpp"
+#include "mlmap/planes/classify.hpp"
 #include "mlmap/map/map_planes.hpp"
 #include "number_options.hpp"
 #include "output_check.hpp"
@@ -13,8 +15,6 @@
 namespace mlmap::cli {
 namespace {
 
-// A level patch's normal lies within 15° of vertical (ClassifyConfig::horizontal_deg).
-constexpr double kLevelCosine = 0.9659;
 
 struct PlanesArguments {
   std::string map;
@@ -69,8 +69,11 @@ int runPlanes(const PlanesArguments& arguments, bool quiet) {
   }
   // Classes are heights above the floor: say when there is none to measure from (a cloud
   // cut above its floor), rather than leave a user to wonder why no table is a table.
-  const bool level = std::any_of(detection.planes.begin(), detection.planes.end(),
-                                 [](const Plane& plane) { return std::abs(plane.normal.z()) >= kLevelCosine; });
+  // Level as classification reads it (ClassifyConfig::horizontal_deg).
+  const double level_cosine = std::cos(ClassifyConfig{}.horizontal_deg * std::numbers::pi / 180.0);
+  const bool level = std::any_of(detection.planes.begin(), detection.planes.end(), [level_cosine](const Plane& plane) {
+    return std::abs(plane.normal.z()) >= level_cosine;
+  });
   const bool floor = std::any_of(detection.planes.begin(), detection.planes.end(),
                                  [](const Plane& plane) { return plane.label == PlaneClass::Floor; });
   if (!quiet && level && !floor) {

@@ -53,6 +53,43 @@ struct Corner {
   }
 };
 
+// A simulated scene's points in the world frame, each with its true plane and the
+// scanner it was seen from, mapped at 5 cm, and the planes detected on that map.
+struct Scanned {
+  std::vector<Point> points;
+  std::vector<std::int32_t> truth;
+  std::vector<Point> scanners;
+  std::vector<std::uint32_t> scanner_of_point;
+  MLMap map{0.05};
+  PlaneDetection detection;
+
+  Scanned(const std::string& scene_json, const std::string& name) {
+    for (const sim::SimulatedScan& simulated : sim::simulate(sim::parseScene(scene_json, name))) {
+      const Scan& scan = simulated.scan;
+      for (std::size_t k = 0; k < scan.size(); ++k) {
+        points.push_back(scan.worldPoint(k));
+        truth.push_back(scan.labels[k]);
+        scanner_of_point.push_back(static_cast<std::uint32_t>(scanners.size()));
+        map.insert(points.back(), scan.variance(k));
+      }
+      scanners.push_back(scan.pose.translation());
+    }
+    detection = detectPlanes(map);
+  }
+
+  PointLabelRefinement options() const {
+    return PointLabelRefinement{.noise = detection.config.noise,
+                                .band = detection.config.epsilon + 0.5 * map.cellSize()};
+  }
+  BeamOrigins beams() const { return BeamOrigins{scanners, scanner_of_point}; }
+  // Each point's collecting block's label (labelPoints).
+  std::vector<std::int32_t> blockLabels() const {
+    Scan all;
+    all.points = points;
+    return labelPoints(map, all);
+  }
+};
+
 }  // namespace
 
 TEST_CASE("Point labels: floor points in the wall's corner blocks leave the wall for the floor") {
@@ -177,34 +214,17 @@ TEST_CASE("Point labels: with the beams' origins, fewer points at edges take the
   // A point near an edge lies within noise of two planes; the likelier one is the plane
   // its beam meets nearer the measured range, and that depends on the point's own beam:
   // the same wall is seen head on from one pose and grazing from another.
-  std::vector<Point> points;
-  std::vector<std::int32_t> truth;
-  std::vector<Point> scanners;
-  std::vector<std::uint32_t> scanner_of_point;
-  MLMap map(0.05);
   // Scanned twice as finely as the shared scene, for enough points at every edge.
   std::string scene_json = test::kRoomsJson;
   scene_json.replace(scene_json.find("\"angular_step_deg\": 1.0"), 23, "\"angular_step_deg\": 0.5");
   scene_json.replace(scene_json.find("\"tilt_step_deg\": 2.0"), 20, "\"tilt_step_deg\": 1.0");
-  for (const sim::SimulatedScan& simulated : sim::simulate(sim::parseScene(scene_json, "rooms.json"))) {
-    const Scan& scan = simulated.scan;
-    for (std::size_t k = 0; k < scan.size(); ++k) {
-      points.push_back(scan.worldPoint(k));
-      truth.push_back(scan.labels[k]);
-      scanner_of_point.push_back(static_cast<std::uint32_t>(scanners.size()));
-      map.insert(points.back(), scan.variance(k));
-    }
-    scanners.push_back(scan.pose.translation());
-  }
-  const PlaneDetection detection = detectPlanes(map);
-  const PointLabelRefinement options{.noise = detection.config.noise,
-                                     .band = detection.config.epsilon + 0.5 * map.cellSize()};
-  Scan all;
-  all.points = points;
-  std::vector<std::int32_t> by_spread = labelPoints(map, all);
-  refinePointLabels(map, detection.planes, points, by_spread, options);
-  std::vector<std::int32_t> by_beam = labelPoints(map, all);
-  refinePointLabels(map, detection.planes, points, by_beam, options, BeamOrigins{scanners, scanner_of_point});
+  const Scanned room(scene_json, "rooms.json");
+  const std::vector<Point>& points = room.points;
+  const std::vector<std::int32_t>& truth = room.truth;
+  std::vector<std::int32_t> by_spread = room.blockLabels();
+  refinePointLabels(room.map, room.detection.planes, points, by_spread, room.options());
+  std::vector<std::int32_t> by_beam = room.blockLabels();
+  refinePointLabels(room.map, room.detection.planes, points, by_beam, room.options(), room.beams());
   // Points on a patch that is mostly another surface's.
   const std::size_t wrong_by_spread = test::labelAgreement(by_spread, truth).misplaced();
   const std::size_t wrong_by_beam = test::labelAgreement(by_beam, truth).misplaced();
@@ -249,28 +269,11 @@ TEST_CASE("Point labels: at the foot of a cabinet and above its side, the floor'
       {"type": "box", "class": "other", "min": [0, 1.0, 0], "max": [0.5, 3.0, 1.8], "omit": ["bottom", "x-"]},
       {"type": "box", "class": "other", "min": [4.0, 1.0, 0], "max": [4.6, 1.5, 0.5], "omit": ["bottom"]}
     ]})";
-  std::vector<Point> points;
-  std::vector<std::int32_t> truth;
-  std::vector<Point> scanners;
-  std::vector<std::uint32_t> scanner_of_point;
-  MLMap map(0.05);
-  for (const sim::SimulatedScan& simulated : sim::simulate(sim::parseScene(scene_json, "cabinet.json"))) {
-    const Scan& scan = simulated.scan;
-    for (std::size_t k = 0; k < scan.size(); ++k) {
-      points.push_back(scan.worldPoint(k));
-      truth.push_back(scan.labels[k]);
-      scanner_of_point.push_back(static_cast<std::uint32_t>(scanners.size()));
-      map.insert(points.back(), scan.variance(k));
-    }
-    scanners.push_back(scan.pose.translation());
-  }
-  const PlaneDetection detection = detectPlanes(map);
-  const PointLabelRefinement options{.noise = detection.config.noise,
-                                     .band = detection.config.epsilon + 0.5 * map.cellSize()};
-  Scan all;
-  all.points = points;
-  std::vector<std::int32_t> labels = labelPoints(map, all);
-  refinePointLabels(map, detection.planes, points, labels, options, BeamOrigins{scanners, scanner_of_point});
+  const Scanned scanned(scene_json, "cabinet.json");
+  const std::vector<Point>& points = scanned.points;
+  const std::vector<std::int32_t>& truth = scanned.truth;
+  std::vector<std::int32_t> labels = scanned.blockLabels();
+  refinePointLabels(scanned.map, scanned.detection.planes, points, labels, scanned.options(), scanned.beams());
   // Each patch's surface: the true plane most of its points lie on.
   std::map<std::int32_t, std::map<std::int32_t, std::size_t>> counts;
   for (std::size_t k = 0; k < points.size(); ++k)

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -34,17 +33,15 @@ void dropBevels(const BlockGrid& grid, PatchSet& set, double epsilon, double kap
   std::vector<double> surface(count, 0.0);
   for (std::size_t k = 0; k < count; ++k)
     for (const std::uint32_t id : set.blocks[k]) surface[k] += grid.blocks()[id].surface;
-  // A bevel has two larger neighbours: the two largest patches are none (nor walked, the
-  // floor and the ceiling of a fine map: hundreds of thousands of blocks).
-  std::vector<double> sorted = surface;
-  std::sort(sorted.begin(), sorted.end(), std::greater<>());
-  const double second_largest = sorted.size() >= 2 ? sorted[1] : std::numeric_limits<double>::infinity();
   // The largest patches by surface: the sides a bevel can have (before the walk that
   // finds which it touches, whether any two of them could hold it between them).
   std::vector<std::size_t> by_surface(count);
   for (std::size_t k = 0; k < count; ++k) by_surface[k] = k;
   std::sort(by_surface.begin(), by_surface.end(), [&](std::size_t a, std::size_t b) { return surface[a] > surface[b]; });
   by_surface.resize(std::min(count, kLargestSides));
+  // A bevel has two larger neighbours: the two largest patches are none (nor walked, the
+  // floor and the ceiling of a fine map: hundreds of thousands of blocks).
+  const double second_largest = count >= 2 ? surface[by_surface[1]] : std::numeric_limits<double>::infinity();
   const auto between = [&](const Eigen::Vector3d& normal, const Eigen::Vector3d& first, const Eigen::Vector3d& second) {
     const double apart = angleBetween(first, second);
     return apart >= std::numbers::pi / 4.0 && angleBetween(normal, first) >= 0.5 * kappa_rad &&

@@ -8,6 +8,7 @@
 #include <functional>
 #include <optional>
 
+#include "bevels.hpp"
 #include "detector.hpp"
 #include "median.hpp"
 #include "mlmap/planes/block_grid.hpp"
@@ -15,7 +16,6 @@
 #include "mlmap/planes/direction_vectors.hpp"
 #include "patch_merges.hpp"
 #include "patch_set.hpp"
-#include "bevels.hpp"
 #include "surface_noise.hpp"
 
 namespace mlmap {

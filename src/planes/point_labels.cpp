@@ -7,8 +7,8 @@
 #include <limits>
 #include <string>
 
-#include "mlmap/error.hpp"
 #include "edge_choice.hpp"
+#include "mlmap/error.hpp"
 #include "pca_sums.hpp"
 
 namespace mlmap {
@@ -92,7 +92,6 @@ void fitPlane(const PcaSums& moments, const Eigen::Vector3d& origin, const Point
 double planeDistance(const PointPlane& plane, const Point& p) {
   return std::abs(plane.normal.dot(p) + plane.offset);
 }
-
 
 }  // namespace
 

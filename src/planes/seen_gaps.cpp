@@ -16,6 +16,12 @@ std::int64_t keyOf(CellIndex cell) {
 
 int chebyshev(CellIndex a, CellIndex b) { return std::max(std::abs(a.i - b.i), std::abs(a.j - b.j)); }
 
+// m: the level plane's height over a cell's centre.
+double heightAt(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eigen::Vector3d& point, CellIndex cell) {
+  const Eigen::Vector2d centre = grid.cellCentre(cell);
+  return point.z() - (normal.x() * (centre.x() - point.x()) + normal.y() * (centre.y() - point.y())) / normal.z();
+}
+
 }  // namespace
 
 bool seenPast(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eigen::Vector3d& point, CellIndex from,
@@ -25,9 +31,7 @@ bool seenPast(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eigen:
     const double t = static_cast<double>(step) / steps;
     const auto i = static_cast<std::int32_t>(std::lround(from.i + t * (to.i - from.i)));
     const auto j = static_cast<std::int32_t>(std::lround(from.j + t * (to.j - from.j)));
-    const Eigen::Vector2d centre = grid.cellCentre(CellIndex{i, j});
-    const double height =
-        point.z() - (normal.x() * (centre.x() - point.x()) + normal.y() * (centre.y() - point.y())) / normal.z();
+    const double height = heightAt(grid, normal, point, CellIndex{i, j});
     bool below = false, at = false;
     grid.forEachInCells(i, i, j, j, [&](std::uint32_t id) {
       const PlaneBlock& block = grid.blocks()[id];
@@ -55,9 +59,7 @@ Beyond beyond(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, c
   Beyond counts;
   for (const std::uint32_t id : blocks) {
     const CellIndex cell = grid.blocks()[id].cell;
-    const Eigen::Vector2d centre = grid.cellCentre(cell);
-    const double height =
-        point.z() - (normal.x() * (centre.x() - point.x()) + normal.y() * (centre.y() - point.y())) / normal.z();
+    const double height = heightAt(grid, normal, point, cell);
     bool above = false, below = false;
     grid.forEachInCells(cell.i, cell.i, cell.j, cell.j, [&](std::uint32_t other) {
       above = above || grid.blocks()[other].bottom > height + tolerance;
