@@ -135,6 +135,10 @@ void addPlanesCommand(CLI::App& app, Context& context) {
             "Mean angle of a plane's blocks' directions to its normal (level planes: beyond their noise), deg", 0.0,
             Bound::Open, 90.0)
       ->capture_default_str();
+  addNumber(command, "--sparse-gap", config.sparse_gap,
+            "Blocks of a surface's sparse parts (no direction) join its patch across gaps up to this, m; 0 = off", 0.0,
+            Bound::Closed, 10.0)
+      ->capture_default_str();
   addNumber(command, "--max-candidates", config.max_candidates, "Max_cp: candidates in all", 1, Bound::Closed)
       ->capture_default_str();
   addNumber(command, "--max-idle-candidates", config.max_idle_candidates,

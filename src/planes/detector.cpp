@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numeric>
 
 #include "fill_vector.hpp"
@@ -84,6 +85,41 @@ void Detector::describePatches() {
     described.candidates = plane.candidates;
     plane = std::move(described);
     patches_.blocks[k] = std::move(patch.blocks);
+  }
+}
+
+// After the search: the patches take the blocks of their surfaces' sparse parts
+// (sparse_growth.hpp), in the order they were found.
+void Detector::growIntoSparse() {
+  if (config_.sparse_gap <= 0.0) return;
+  // Planes within the classes' tolerance of level or plumb (floors, ceilings, tables, walls).
+  const SparseGrowth growth{config_.sparse_gap, radians(config_.kappa_deg), radians(ClassifyConfig{}.horizontal_deg),
+                             config_.ladder_gap};
+  const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * growth.kappa_rad, std::numbers::pi / 2)));
+  for (std::size_t k = 0; k < patches_.planes.size(); ++k) {
+    const CandidatePlane& reference = undescribed_[k].reference;
+    const float band = scorer_.bandOf(reference);
+    std::vector<std::uint32_t> candidates;
+    for (const std::vector<std::uint32_t>& ids : {scorer_.matching(reference), scorer_.near(reference, cos_edge, band)}) {
+      for (const std::uint32_t id : ids) {
+        if (patches_.labels[id] == 0) candidates.push_back(id);
+      }
+    }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    const std::vector<std::uint32_t> grown =
+        sparseGrowth(grid_, directions_, candidates, patches_.blocks[k], reference, band, growth);
+    if (grown.empty()) continue;
+    const std::int32_t id = patches_.planes[k].id;
+    for (const std::uint32_t block : grown) {
+      patches_.labels[block] = id;
+      undescribed_[k].surface += grid_.blocks()[block].surface;
+    }
+    std::vector<std::uint32_t> blocks;
+    blocks.reserve(patches_.blocks[k].size() + grown.size());
+    std::merge(patches_.blocks[k].begin(), patches_.blocks[k].end(), grown.begin(), grown.end(), std::back_inserter(blocks));
+    patches_.blocks[k] = std::move(blocks);
+    patches_.outline_runs[k].clear();
   }
 }
 
@@ -347,6 +383,9 @@ PatchSet Detector::run(ErmsmStats& stats) {
     }
   }
   stats.accepted = static_cast<std::size_t>(accepted_);
+  const auto growth_start = Clock::now();
+  growIntoSparse();
+  stats.stages.patches += secondsSince(growth_start);
   const auto describe_start = Clock::now();
   describePatches();
   stats.stages.patches += secondsSince(describe_start);

@@ -21,6 +21,7 @@
 #include "patch_merges.hpp"
 #include "patch_set.hpp"
 #include "plane_scorer.hpp"
+#include "sparse_growth.hpp"
 
 namespace mlmap {
 
@@ -95,6 +96,7 @@ class Detector {
   };
   std::vector<Undescribed> undescribed_;
   void describePatches();
+  void growIntoSparse();
 };
 
 }  // namespace mlmap

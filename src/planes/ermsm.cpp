@@ -247,6 +247,9 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
 ErmsmConfig measuringPass(const ErmsmConfig& config) {
   ErmsmConfig measuring = config;
   measuring.max_idle_candidates = std::min(config.max_idle_candidates, 100);
+  // Nor do sparse parts (sparse_growth.hpp) join its patches: they are few blocks of
+  // one or two points, whose scatter is no measure of σ.
+  measuring.sparse_gap = 0.0;
   return measuring;
 }
 

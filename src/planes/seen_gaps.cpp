@@ -16,13 +16,12 @@ std::int64_t keyOf(CellIndex cell) {
 
 int chebyshev(CellIndex a, CellIndex b) { return std::max(std::abs(a.i - b.i), std::abs(a.j - b.j)); }
 
-// m: the level plane's height over a cell's centre.
+}  // namespace
+
 double heightAt(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eigen::Vector3d& point, CellIndex cell) {
   const Eigen::Vector2d centre = grid.cellCentre(cell);
   return point.z() - (normal.x() * (centre.x() - point.x()) + normal.y() * (centre.y() - point.y())) / normal.z();
 }
-
-}  // namespace
 
 bool seenPast(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eigen::Vector3d& point, CellIndex from,
               CellIndex to, double tolerance) {

@@ -14,6 +14,9 @@
 
 namespace mlmap {
 
+// m: the level plane's (`normal`, through `point`) height over a cell's centre.
+double heightAt(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eigen::Vector3d& point, CellIndex cell);
+
 // Whether the scanner saw past the level plane (`normal`, through `point`) on the cells
 // strictly between `from` and `to`: one of them holds a block more than `tolerance`
 // under the plane and none at the plane.

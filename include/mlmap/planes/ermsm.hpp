@@ -57,6 +57,10 @@ struct ErmsmConfig {
   // squares): where a surface's points scatter by a good part of a cell (3DTK's ceiling at
   // 5 cm) noise alone spreads its directions by more than 8°.
   double max_direction_spread_deg = 8.0;
+  // m: after the search, a patch takes the blocks of its surface that no window could
+  // give a direction (scan lines further apart than it), each within this of the patch
+  // or of one that joined, across gaps nothing was seen past (sparse_growth.hpp); 0 = off.
+  double sparse_gap = 0.6;
   int max_candidates = 4000;      // Max_cp: Algorithm 1 stops after this many candidates
   int max_idle_candidates = 300;  // ... or after this many without an accepted plane
   int batch_size = 16;            // candidates per iteration of Algorithm 1 (fixed, not per thread)

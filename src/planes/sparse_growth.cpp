@@ -1,0 +1,153 @@
+#include "sparse_growth.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <numbers>
+
+#include "id_set.hpp"
+#include "seen_gaps.hpp"
+
+namespace mlmap {
+namespace {
+
+// m: how far a wall looks either side for what was seen through an opening (as
+// joinUnseenGaps: a doorway shows the floor beyond it).
+constexpr double kOpeningReach = 0.3;
+
+struct GrowthPlane {
+  Eigen::Vector3d normal;
+  Eigen::Vector3d point;
+  double epsilon = 0.0;
+  bool level = false;
+  bool seen_from_above = false;  // level: what lies past it is below (a floor, a table), else above (a ceiling)
+};
+
+// m: the gap between two blocks on the plane: across (their points, in the plane) and,
+// on a wall, up (between their extents: a wall block is tall).
+double gapBetween(const PlaneBlock& a, const PlaneBlock& b, const GrowthPlane& plane) {
+  Eigen::Vector3d step = (b.point - a.point).cast<double>();
+  step -= plane.normal * plane.normal.dot(step);
+  if (plane.level) return step.norm();
+  const double vertical = std::max({0.0, static_cast<double>(b.bottom - a.top), static_cast<double>(a.bottom - b.top)});
+  return std::hypot(std::hypot(step.x(), step.y()), vertical);
+}
+
+// Whether the cells strictly between the two blocks' show the scanner saw past the
+// plane there: a level plane's far side (with nothing at the plane in that cell), or a
+// wall's both sides (an opening).
+bool seenPastBetween(const BlockGrid& grid, const GrowthPlane& plane, CellIndex from, CellIndex to) {
+  const int steps = std::max(std::abs(from.i - to.i), std::abs(from.j - to.j));
+  bool front = false;
+  bool behind = false;
+  for (int step = 1; step < steps; ++step) {
+    const double t = static_cast<double>(step) / steps;
+    const CellIndex cell{static_cast<std::int32_t>(std::lround(from.i + t * (to.i - from.i))),
+                         static_cast<std::int32_t>(std::lround(from.j + t * (to.j - from.j)))};
+    if (plane.level) {
+      const double height = heightAt(grid, plane.normal, plane.point, cell);
+      bool beyond = false, at = false;
+      grid.forEachInCells(cell.i, cell.i, cell.j, cell.j, [&](std::uint32_t id) {
+        const PlaneBlock& block = grid.blocks()[id];
+        if (plane.seen_from_above ? block.top < height - plane.epsilon : block.bottom > height + plane.epsilon) {
+          beyond = true;
+        } else if (block.bottom <= height + plane.epsilon && block.top >= height - plane.epsilon) {
+          at = true;
+        }
+      });
+      if (beyond && !at) return true;
+      continue;
+    }
+    grid.forEachInCells(cell.i, cell.i, cell.j, cell.j, [&](std::uint32_t id) {
+      const double distance = plane.normal.dot(grid.blocks()[id].point.cast<double>() - plane.point);
+      if (std::abs(distance) <= plane.epsilon || std::abs(distance) > kOpeningReach) return;
+      (distance > 0.0 ? front : behind) = true;
+    });
+    if (front && behind) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
+                                        const std::vector<std::uint32_t>& candidates,
+                                        const std::vector<std::uint32_t>& patch, const CandidatePlane& reference,
+                                        double epsilon, const SparseGrowth& config) {
+  if (config.max_gap <= 0.0 || candidates.empty() || patch.empty()) return {};
+  // Only level and plumb planes: a tilted plane through sparse blocks is as likely the
+  // envelope of a staircase's nosings (fr079's stair at 10 cm cells, 23°) as a ramp, and
+  // grown it took every tread within its ε.
+  const double tilt = std::acos(std::min(1.0, static_cast<double>(std::abs(reference.normal.normalized().z()))));
+  if (std::min(tilt, std::numbers::pi / 2 - tilt) > config.max_tilt_rad) return {};
+  GrowthPlane plane{reference.normal.cast<double>().normalized(), reference.point.cast<double>(), epsilon,
+                    std::abs(reference.normal.z()) >= std::cos(std::numbers::pi / 4.0), false};
+  if (plane.level) plane.seen_from_above = seenFromAbove(grid, patch, plane.normal, plane.point, epsilon);
+  const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * config.kappa_rad, std::numbers::pi / 2)));
+  IdSet pool(grid.size());
+  std::size_t pooled = 0;
+  for (const std::uint32_t id : candidates) {
+    const PlaneBlock& block = grid.blocks()[id];
+    if (plane.level && block.vertical) continue;
+    // A short block with another of its cell less than a ladder gap above or below is a
+    // rung of a wall seen from afar (fr079 at 5 cm: a table's plane took 96 points of the
+    // wall beside it), not a piece of a level surface.
+    if (plane.level) {
+      bool rung = false;
+      grid.forEachInCells(block.cell.i, block.cell.i, block.cell.j, block.cell.j, [&](std::uint32_t other) {
+        if (other == id) return;
+        const PlaneBlock& near = grid.blocks()[other];
+        rung = rung || (near.bottom < block.top + config.ladder_gap && near.top > block.bottom - config.ladder_gap);
+      });
+      if (rung) continue;
+    }
+    const Eigen::Vector3f& direction = directions[id];
+    if (direction.squaredNorm() > 0.0F && std::abs(direction.dot(reference.normal)) < cos_edge) continue;
+    if (std::abs(plane.normal.dot(block.point.cast<double>() - plane.point)) >= epsilon) continue;
+    pool.insert(id);
+    ++pooled;
+  }
+  if (pooled == 0) return {};
+  IdSet inside(grid.size());
+  for (const std::uint32_t id : patch) inside.insert(id);
+  const int reach = static_cast<int>(std::ceil(config.max_gap / grid.cellSize()));
+  IdSet joined(grid.size());
+  std::deque<std::uint32_t> queue;
+  // From the patch: each candidate by its nearest patch block within reach.
+  for (const std::uint32_t id : candidates) {
+    if (!pool.contains(id)) continue;
+    const PlaneBlock& block = grid.blocks()[id];
+    double nearest = config.max_gap;
+    std::uint32_t from = 0;
+    bool found = false;
+    grid.forEachNeighbour(block.cell, reach, [&](std::uint32_t other) {
+      if (!inside.contains(other)) return;
+      const double gap = gapBetween(grid.blocks()[other], block, plane);
+      if (gap <= nearest) {
+        nearest = gap;
+        from = other;
+        found = true;
+      }
+    });
+    if (found && !seenPastBetween(grid, plane, grid.blocks()[from].cell, block.cell)) {
+      joined.insert(id);
+      queue.push_back(id);
+    }
+  }
+  // Then block by block from those that joined.
+  while (!queue.empty()) {
+    const std::uint32_t id = queue.front();
+    queue.pop_front();
+    const PlaneBlock& block = grid.blocks()[id];
+    grid.forEachNeighbour(block.cell, reach, [&](std::uint32_t other) {
+      if (!pool.contains(other) || joined.contains(other)) return;
+      const PlaneBlock& next = grid.blocks()[other];
+      if (gapBetween(block, next, plane) > config.max_gap || seenPastBetween(grid, plane, block.cell, next.cell)) return;
+      joined.insert(other);
+      queue.push_back(other);
+    });
+  }
+  return joined.ascending();
+}
+
+}  // namespace mlmap

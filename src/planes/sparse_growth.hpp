@@ -1,0 +1,37 @@
+// Beyond the paper: surfaces far from the scanner. There its scan lines lie further
+// apart than a direction window (PCL's room scans: the floor 5-7 m out is lines of
+// points 10 cm apart, the lines 0.35-0.7 m apart), so a block's window holds one line
+// or none: the block gets no direction, no candidate is seeded on it, no plane matches
+// it, and the piece a plane does match is a strip one line wide that the patch rules
+// drop. A person sees the floor go on to the far wall. After the search, such blocks
+// join a patch whose plane they lie on (within its ε), linked to it block by block
+// across gaps of at most `max_gap` in which nothing was seen past the plane.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "mlmap/planes/block_grid.hpp"
+#include "plane_scorer.hpp"
+
+namespace mlmap {
+
+struct SparseGrowth {
+  double max_gap = 0.0;     // m, the longest step from block to block (in the plane)
+  double kappa_rad = 0.0;   // blocks with a direction join within 2 κ of the plane's normal
+  double max_tilt_rad = 0.0;  // only planes this close to level or to plumb grow
+  double ladder_gap = 0.0;    // m: ErmsmConfig::ladder_gap, what tells a sparse wall's rungs
+};
+
+// The blocks of `candidates` (untaken blocks near the plane: within `epsilon`, level
+// ones only for a plane within 45° of level) that `patch` reaches: each within
+// max_gap of the patch or of a block that joined, with no block seen past the plane in
+// the cells between (for a level plane, on the side away from where it was seen; for
+// a wall, on both sides within 0.3 m: an opening). `labels` (per block id, 0 = free)
+// must hold 0 for every candidate; `patch` ascending. Returns the joined ids ascending.
+std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
+                                        const std::vector<std::uint32_t>& candidates,
+                                        const std::vector<std::uint32_t>& patch, const CandidatePlane& plane,
+                                        double epsilon, const SparseGrowth& config);
+
+}  // namespace mlmap
