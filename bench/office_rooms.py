@@ -10,6 +10,7 @@ tables); walls, floor, ceiling and the desk and sideboard tops carry their class
 rest is "other".
 
     /usr/bin/python3 bench/office_rooms.py SEED > office.json   (the scene, to look at)
+    /usr/bin/python3 bench/office_rooms.py hall-SEED > hall.json (hall_room: a large hall, sparse far half)
 """
 import json
 import math
@@ -129,5 +130,41 @@ def office_room(seed):
             "surfaces": surfaces}
 
 
+def hall_room(seed):
+    """A hall 12-18 m long scanned from near one end by a coarser laser (0.5 deg steps,
+    1 deg tilt steps): its far floor, ceiling and walls are scan lines tens of cm apart,
+    as a real scan's far half is. Desk rows, a sideboard or a cabinet; one or two poses."""
+    rng = np.random.default_rng(9000 + seed)
+    w, d, h = rng.uniform(12.0, 18.0), rng.uniform(6.0, 10.0), rng.uniform(2.8, 4.0)
+    surfaces = [rect([0, 0, 0], [w, d, 0], "floor"), rect([0, 0, h], [w, d, h], "ceiling"),
+                rect([0, 0, 0], [0, d, h], "wall", "+x"), rect([w, 0, 0], [w, d, h], "wall", "-x"),
+                rect([0, 0, 0], [w, 0, h], "wall", "+y"), rect([0, d, 0], [w, d, h], "wall", "-y")]
+    taken = []
+    length = rng.uniform(1.5, 3.0)
+    x0 = rng.uniform(4.0, w - length - 0.5)
+    height = rng.uniform(0.8, 1.0) if rng.random() < 0.6 else rng.uniform(1.8, 2.1)
+    surfaces.append({"type": "box", "class": "other", "min": [x0, 0.0, 0.0], "max": [x0 + length, 0.45, height],
+                     "omit": ["bottom", "y-"], **({"classes": {"top": "table"}} if height < 1.2 else {})})
+    taken.append((x0 + length / 2, 0.3, length / 2 + 0.3))
+    for _ in range(int(rng.integers(2, 5))):
+        for _ in range(100):
+            cx, cy, yaw = rng.uniform(3.0, w - 1.5), rng.uniform(1.5, d - 1.5), rng.uniform(-90, 90)
+            row, radius = desk_row(rng, cx, cy, yaw)
+            if all(math.hypot(cx - x, cy - y) > radius + r for x, y, r in taken) and \
+                    radius < min(cx, cy, w - cx, d - cy) + 0.8:
+                surfaces += row
+                taken.append((cx, cy, radius))
+                break
+    poses = [{"x": float(rng.uniform(1.0, 2.5)), "y": float(rng.uniform(1.5, d - 1.5)),
+              "yaw_deg": float(rng.uniform(-30, 30))}]
+    if rng.random() < 0.5:
+        poses.append({"x": float(rng.uniform(2.5, 4.0)), "y": float(rng.uniform(1.5, d - 1.5)),
+                      "yaw_deg": float(rng.uniform(-30, 30))})
+    pattern = dict(PATTERN, seed=seed, angular_step_deg=0.5, tilt_step_deg=1.0)
+    return {"name": f"hall-{seed}", "scan_pattern": pattern, "poses": poses, "surfaces": surfaces}
+
+
 if __name__ == "__main__":
-    json.dump(office_room(int(sys.argv[1]) if len(sys.argv) > 1 else 1), sys.stdout, indent=1)
+    kind, _, number = (sys.argv[1] if len(sys.argv) > 1 else "1").rpartition("-")
+    make = hall_room if kind == "hall" else office_room
+    json.dump(make(int(number)), sys.stdout, indent=1)

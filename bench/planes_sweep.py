@@ -8,7 +8,9 @@ maps/corridor.json lie along the map grid, most on cell boundaries; no real buil
         [--conditions base,noise2,noise3,lines2,sparse,yup] [--json out/sweep/sweep.json]
 
 Scenes: maps/NAME.json, or office-S: an office generated from seed S (bench/office_rooms.py;
-offices 1-4 were looked at while changing the detector, report on others). Every variant
+offices 1-4 were looked at while changing the detector, report on others), or hall-S: a hall
+12-18 m long scanned from near one end by a coarser laser (its far half sparse; halls 1-2 looked
+at, report on others). Every variant
 also prints the walls, floor, ceiling and table tops matched and their F1 with only those
 classes labelled (the other true faces unlabelled, patches counted where they touch a
 labelled one: issue 19's held-out measure as read here).
@@ -201,8 +203,9 @@ def read_label_ply(path):
 
 def simulate(mlmap, scene, condition, sim_root, fresh):
     """The scene under a condition, simulated once and cached by the scene's text."""
-    generated = re.fullmatch(r"office-(\d+)", scene)
-    description = (office_rooms.office_room(int(generated.group(1))) if generated
+    generated = re.fullmatch(r"(office|hall)-(\d+)", scene)
+    make = office_rooms.hall_room if generated and generated.group(1) == "hall" else office_rooms.office_room
+    description = (make(int(generated.group(2))) if generated
                    else json.load(open(os.path.join(ROOT, "maps", scene + ".json"))))
     pattern = dict(CONDITIONS[condition])
     if "tilt_step_x" in pattern:
