@@ -99,14 +99,10 @@ void Detector::growIntoSparse() {
   for (std::size_t k = 0; k < patches_.planes.size(); ++k) {
     const CandidatePlane& reference = undescribed_[k].reference;
     const float band = scorer_.bandOf(reference);
-    std::vector<std::uint32_t> candidates;
-    for (const std::vector<std::uint32_t>& ids : {scorer_.matching(reference), scorer_.near(reference, cos_edge, band)}) {
-      for (const std::uint32_t id : ids) {
-        if (patches_.labels[id] == 0) candidates.push_back(id);
-      }
-    }
-    std::sort(candidates.begin(), candidates.end());
-    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    // The untaken blocks within the band, matching or not (ascending); those an earlier
+    // patch grew into are taken by it.
+    std::vector<std::uint32_t> candidates = scorer_.near(reference, cos_edge, band, true);
+    std::erase_if(candidates, [&](std::uint32_t id) { return patches_.labels[id] != 0; });
     const std::vector<std::uint32_t> grown =
         sparseGrowth(grid_, directions_, candidates, patches_.blocks[k], reference, band, growth);
     if (grown.empty()) continue;

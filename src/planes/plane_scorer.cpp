@@ -143,14 +143,15 @@ std::vector<std::uint32_t> PlaneScorer::matching(const CandidatePlane& plane) co
   return ids.ascending();
 }
 
-std::vector<std::uint32_t> PlaneScorer::near(const CandidatePlane& plane, float cos_cone, float reach) const {
+std::vector<std::uint32_t> PlaneScorer::near(const CandidatePlane& plane, float cos_cone, float reach,
+                                             bool with_matching) const {
   // A little wider than asked: n·p + d here, where callers test n·(p − q) (another rounding).
   constexpr float kSlack = 1e-4F;
   IdSet ids(grid_.size());
   const Query query{plane.normal, -plane.normal.dot(plane.point), cos_cone - kSlack, reach + kSlack};
   // Tiles whose blocks all match the plane are left out: the caller has those.
   const Query matching{plane.normal, query.offset, cos_kappa_, bandOf(plane)};
-  collect(query, &matching, ids);
+  collect(query, with_matching ? nullptr : &matching, ids);
   for (std::size_t n = 0; n < undirected_.size(); ++n) {
     const std::uint32_t id = undirected_[n];
     if (std::abs(query.normal.dot(undirected_points_[n]) + query.offset) < query.epsilon && taken_[id] == 0) {

@@ -54,7 +54,9 @@ class PlaneScorer {
   // Ids of the untaken blocks near the plane, ascending: within `reach` (m) of it, and
   // with a direction within the cone of cosine `cos_cone` about its normal or none. A
   // little wider than asked (float rounding): the caller applies its exact test.
-  std::vector<std::uint32_t> near(const CandidatePlane& plane, float cos_cone, float reach) const;
+  // With `with_matching`, also the blocks that match the plane (else the caller has them).
+  std::vector<std::uint32_t> near(const CandidatePlane& plane, float cos_cone, float reach,
+                                  bool with_matching = false) const;
 
   // Takes the blocks out of the pool (an accepted plane's); the nodes' sums follow.
   void take(const std::vector<std::uint32_t>& ids);

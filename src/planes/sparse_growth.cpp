@@ -4,6 +4,9 @@
 #include <cmath>
 #include <deque>
 #include <numbers>
+#include <optional>
+#include <unordered_map>
+#include <utility>
 
 #include "id_set.hpp"
 #include "seen_gaps.hpp"
@@ -82,7 +85,15 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
   if (std::min(tilt, std::numbers::pi / 2 - tilt) > config.max_tilt_rad) return {};
   GrowthPlane plane{reference.normal.cast<double>().normalized(), reference.point.cast<double>(), epsilon,
                     std::abs(reference.normal.z()) >= std::cos(std::numbers::pi / 4.0), false};
-  if (plane.level) plane.seen_from_above = seenFromAbove(grid, patch, plane.normal, plane.point, epsilon);
+  if (plane.level) {
+    // A majority over at most 4096 of its blocks, evenly spread: a floor at 2 cm has
+    // 150 000, and asking each of them cost more than the growth itself.
+    const std::size_t stride = std::max<std::size_t>(1, patch.size() / 4096);
+    std::vector<std::uint32_t> sample;
+    sample.reserve(patch.size() / stride + 1);
+    for (std::size_t k = 0; k < patch.size(); k += stride) sample.push_back(patch[k]);
+    plane.seen_from_above = seenFromAbove(grid, sample, plane.normal, plane.point, epsilon);
+  }
   const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * config.kappa_rad, std::numbers::pi / 2)));
   IdSet pool(grid.size());
   std::size_t pooled = 0;
@@ -113,39 +124,68 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
   const int reach = static_cast<int>(std::ceil(config.max_gap / grid.cellSize()));
   IdSet joined(grid.size());
   std::deque<std::uint32_t> queue;
-  // From the patch: each candidate by its nearest patch block within reach.
-  for (const std::uint32_t id : candidates) {
-    if (!pool.contains(id)) continue;
-    const PlaneBlock& block = grid.blocks()[id];
+  // The patch block nearest to `block` within `radius` cells and max_gap, if any.
+  const auto nearestInside = [&](const PlaneBlock& block, int radius) -> std::optional<std::uint32_t> {
     double nearest = config.max_gap;
-    std::uint32_t from = 0;
-    bool found = false;
-    grid.forEachNeighbour(block.cell, reach, [&](std::uint32_t other) {
+    std::optional<std::uint32_t> from;
+    grid.forEachNeighbour(block.cell, radius, [&](std::uint32_t other) {
       if (!inside.contains(other)) return;
       const double gap = gapBetween(grid.blocks()[other], block, plane);
       if (gap <= nearest) {
         nearest = gap;
         from = other;
-        found = true;
       }
     });
-    if (found && !seenPastBetween(grid, plane, grid.blocks()[from].cell, block.cell)) {
+    return from;
+  };
+  // From the patch: each candidate by its nearest patch block, looked for next to it
+  // first (most candidates are the patch's own edges: a window of max_gap over a 2 cm
+  // floor holds thousands of blocks), then within max_gap.
+  const int near_radius = std::min(reach, 2);
+  for (const std::uint32_t id : candidates) {
+    if (!pool.contains(id)) continue;
+    const PlaneBlock& block = grid.blocks()[id];
+    std::optional<std::uint32_t> from = nearestInside(block, near_radius);
+    if (!from && reach > near_radius) from = nearestInside(block, reach);
+    if (from && !seenPastBetween(grid, plane, grid.blocks()[*from].cell, block.cell)) {
       joined.insert(id);
       queue.push_back(id);
     }
   }
-  // Then block by block from those that joined.
-  while (!queue.empty()) {
+  // Then block by block from those that joined, among the candidates only: they are
+  // bucketed by squares of max_gap, so a step looks at nine buckets, not at every block
+  // within max_gap.
+  const auto bucket_of = [reach](CellIndex cell) {
+    const auto floor_div = [](std::int64_t a, std::int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); };
+    return std::pair<std::int64_t, std::int64_t>{floor_div(cell.i, reach), floor_div(cell.j, reach)};
+  };
+  const auto key_of = [](std::int64_t bi, std::int64_t bj) { return (bi << 32) ^ (bj & 0xffffffffLL); };
+  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> buckets;
+  for (const std::uint32_t id : candidates) {
+    if (!pool.contains(id) || joined.contains(id)) continue;
+    const auto [bi, bj] = bucket_of(grid.blocks()[id].cell);
+    buckets[key_of(bi, bj)].push_back(id);
+  }
+  while (!queue.empty() && !buckets.empty()) {
     const std::uint32_t id = queue.front();
     queue.pop_front();
     const PlaneBlock& block = grid.blocks()[id];
-    grid.forEachNeighbour(block.cell, reach, [&](std::uint32_t other) {
-      if (!pool.contains(other) || joined.contains(other)) return;
-      const PlaneBlock& next = grid.blocks()[other];
-      if (gapBetween(block, next, plane) > config.max_gap || seenPastBetween(grid, plane, block.cell, next.cell)) return;
-      joined.insert(other);
-      queue.push_back(other);
-    });
+    const auto [bi, bj] = bucket_of(block.cell);
+    for (std::int64_t di = -1; di <= 1; ++di) {
+      for (std::int64_t dj = -1; dj <= 1; ++dj) {
+        const auto found = buckets.find(key_of(bi + di, bj + dj));
+        if (found == buckets.end()) continue;
+        for (const std::uint32_t other : found->second) {
+          if (joined.contains(other)) continue;
+          const PlaneBlock& next = grid.blocks()[other];
+          if (gapBetween(block, next, plane) > config.max_gap || seenPastBetween(grid, plane, block.cell, next.cell)) {
+            continue;
+          }
+          joined.insert(other);
+          queue.push_back(other);
+        }
+      }
+    }
   }
   return joined.ascending();
 }
