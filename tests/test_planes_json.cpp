@@ -106,6 +106,11 @@ TEST_CASE("PlanesJson: an export reads back to the same planes") {
   CHECK(measured_back.stats.passes == 2);
   CHECK(back.stats.prior_noise == doctest::Approx(detection.stats.prior_noise));
   CHECK(back.stats.passes == detection.stats.passes);
+  // The sparse gap the planes were grown with (0.6 m by default) is recorded and read back.
+  PlaneDetection no_growth = detection;
+  no_growth.config.sparse_gap = 0.0;
+  CHECK(io::parsePlanesJson(io::planesJson(map, no_growth, "room.mlmap"), "room.json").config.sparse_gap == 0.0);
+  CHECK(back.config.sparse_gap == doctest::Approx(detection.config.sparse_gap));
 }
 
 TEST_CASE("PlanesJson: a plane per line, outline corners and centroids to the micrometre") {

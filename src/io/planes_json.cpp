@@ -74,6 +74,7 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
                         {"stack_gap", config.stack_gap},
                         {"ladder_gap", config.ladder_gap},
                         {"ladder_blocks", config.ladder_blocks},
+                        {"sparse_gap", config.sparse_gap},
                         {"seed", config.seed}};
   const ErmsmStats& run = detection.stats;
   json["detection"] = {{"candidates", run.candidates},

@@ -127,6 +127,7 @@ ErmsmConfig readParameters(const Reader& reader, const json& parameters) {
   optional_number("stack_gap", config.stack_gap);
   optional_number("ladder_gap", config.ladder_gap);
   optional_number("ladder_blocks", config.ladder_blocks);
+  optional_number("sparse_gap", config.sparse_gap);
   return config;
 }
 

@@ -18,6 +18,9 @@ namespace {
 // joinUnseenGaps: a doorway shows the floor beyond it).
 constexpr double kOpeningReach = 0.3;
 
+// m: the widest gap a patch grows across, whatever it is configured with.
+constexpr double kMaxGap = 10.0;
+
 struct GrowthPlane {
   Eigen::Vector3d normal;
   Eigen::Vector3d point;
@@ -77,7 +80,7 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
                                         const std::vector<std::uint32_t>& candidates,
                                         const std::vector<std::uint32_t>& patch, const CandidatePlane& reference,
                                         double epsilon, const SparseGrowth& config) {
-  if (config.max_gap <= 0.0 || candidates.empty() || patch.empty()) return {};
+  if (!(config.max_gap > 0.0) || candidates.empty() || patch.empty()) return {};
   // Only level and plumb planes: a tilted plane through sparse blocks is as likely the
   // envelope of a staircase's nosings (fr079's stair at 10 cm cells, 23°) as a ramp, and
   // grown it took every tread within its ε.
@@ -121,12 +124,14 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
   if (pooled == 0) return {};
   IdSet inside(grid.size());
   for (const std::uint32_t id : patch) inside.insert(id);
-  const int reach = static_cast<int>(std::ceil(config.max_gap / grid.cellSize()));
+  // At most kMaxGap (a configuration read from a file is not bounded as the CLI's is).
+  const double max_gap = std::min(config.max_gap, kMaxGap);
+  const int reach = static_cast<int>(std::ceil(max_gap / grid.cellSize()));
   IdSet joined(grid.size());
   std::deque<std::uint32_t> queue;
   // The patch block nearest to `block` within `radius` cells and max_gap, if any.
   const auto nearestInside = [&](const PlaneBlock& block, int radius) -> std::optional<std::uint32_t> {
-    double nearest = config.max_gap;
+    double nearest = max_gap;
     std::optional<std::uint32_t> from;
     grid.forEachNeighbour(block.cell, radius, [&](std::uint32_t other) {
       if (!inside.contains(other)) return;
@@ -178,7 +183,7 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
         for (const std::uint32_t other : found->second) {
           if (joined.contains(other)) continue;
           const PlaneBlock& next = grid.blocks()[other];
-          if (gapBetween(block, next, plane) > config.max_gap || seenPastBetween(grid, plane, block.cell, next.cell)) {
+          if (gapBetween(block, next, plane) > max_gap || seenPastBetween(grid, plane, block.cell, next.cell)) {
             continue;
           }
           joined.insert(other);
