@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <numeric>
 
 #include "fill_vector.hpp"
@@ -95,28 +94,14 @@ void Detector::growIntoSparse() {
   // Planes within the classes' tolerance of level or plumb (floors, ceilings, tables, walls).
   const SparseGrowth growth{config_.sparse_gap, radians(config_.kappa_deg), radians(ClassifyConfig{}.horizontal_deg),
                              config_.ladder_gap};
-  const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * growth.kappa_rad, std::numbers::pi / 2)));
-  for (std::size_t k = 0; k < patches_.planes.size(); ++k) {
-    const CandidatePlane& reference = undescribed_[k].reference;
-    const float band = scorer_.bandOf(reference);
-    // The untaken blocks within the band, matching or not (ascending); those an earlier
-    // patch grew into are taken by it.
-    std::vector<std::uint32_t> candidates = scorer_.near(reference, cos_edge, band, true);
-    std::erase_if(candidates, [&](std::uint32_t id) { return patches_.labels[id] != 0; });
-    const std::vector<std::uint32_t> grown =
-        sparseGrowth(grid_, directions_, candidates, patches_.blocks[k], reference, band, growth);
-    if (grown.empty()) continue;
-    const std::int32_t id = patches_.planes[k].id;
-    for (const std::uint32_t block : grown) {
-      patches_.labels[block] = id;
-      undescribed_[k].surface += grid_.blocks()[block].surface;
-    }
-    std::vector<std::uint32_t> blocks;
-    blocks.reserve(patches_.blocks[k].size() + grown.size());
-    std::merge(patches_.blocks[k].begin(), patches_.blocks[k].end(), grown.begin(), grown.end(), std::back_inserter(blocks));
-    patches_.blocks[k] = std::move(blocks);
-    patches_.outline_runs[k].clear();
+  std::vector<CandidatePlane> references;
+  std::vector<double> surfaces;
+  for (const Undescribed& patch : undescribed_) {
+    references.push_back(patch.reference);
+    surfaces.push_back(patch.surface);
   }
+  growPatches(grid_, directions_, scorer_, references, surfaces, patches_, growth);
+  for (std::size_t k = 0; k < undescribed_.size(); ++k) undescribed_[k].surface = surfaces[k];
 }
 
 // bestCandidate of Algorithm 1, lazily: a stale score is an upper bound (taking

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <iterator>
 #include <numbers>
 #include <optional>
 #include <unordered_map>
@@ -193,6 +194,32 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
     }
   }
   return joined.ascending();
+}
+
+void growPatches(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions, const PlaneScorer& scorer,
+                 const std::vector<CandidatePlane>& references, std::vector<double>& surfaces, PatchSet& set,
+                 const SparseGrowth& config) {
+  const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * config.kappa_rad, std::numbers::pi / 2)));
+  for (std::size_t k = 0; k < set.planes.size(); ++k) {
+    const CandidatePlane& reference = references[k];
+    const float band = scorer.bandOf(reference);
+    // The untaken blocks within the band, matching or not (ascending), but those an
+    // earlier patch grew into.
+    std::vector<std::uint32_t> candidates = scorer.near(reference, cos_edge, band, true);
+    std::erase_if(candidates, [&](std::uint32_t id) { return set.labels[id] != 0; });
+    const std::vector<std::uint32_t> grown =
+        sparseGrowth(grid, directions, candidates, set.blocks[k], reference, band, config);
+    if (grown.empty()) continue;
+    for (const std::uint32_t block : grown) {
+      set.labels[block] = set.planes[k].id;
+      surfaces[k] += grid.blocks()[block].surface;
+    }
+    std::vector<std::uint32_t> blocks;
+    blocks.reserve(set.blocks[k].size() + grown.size());
+    std::merge(set.blocks[k].begin(), set.blocks[k].end(), grown.begin(), grown.end(), std::back_inserter(blocks));
+    set.blocks[k] = std::move(blocks);
+    set.outline_runs[k].clear();
+  }
 }
 
 }  // namespace mlmap

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "mlmap/planes/block_grid.hpp"
+#include "patch_set.hpp"
 #include "plane_scorer.hpp"
 
 namespace mlmap {
@@ -23,15 +24,22 @@ struct SparseGrowth {
   double ladder_gap = 0.0;    // m: ErmsmConfig::ladder_gap, what tells a sparse wall's rungs
 };
 
-// The blocks of `candidates` (untaken blocks near the plane: within `epsilon`, level
-// ones only for a plane within 45° of level) that `patch` reaches: each within
-// max_gap of the patch or of a block that joined, with no block seen past the plane in
-// the cells between (for a level plane, on the side away from where it was seen; for
-// a wall, on both sides within 0.3 m: an opening). `labels` (per block id, 0 = free)
-// must hold 0 for every candidate; `patch` ascending. Returns the joined ids ascending.
+// The blocks of `candidates` (free blocks near the plane: those within `epsilon`, and
+// for a plane within 45° of level only level ones that are no rung of a wall) that `patch`
+// reaches: each within max_gap of the patch or of a block that joined, with no block seen
+// past the plane in the cells between (for a level plane, on the side away from where it
+// was seen; for a wall, on both sides within 0.3 m: an opening). `patch` ascending.
+// Returns the joined ids ascending; none for a plane tilted more than max_tilt_rad.
 std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                         const std::vector<std::uint32_t>& candidates,
                                         const std::vector<std::uint32_t>& patch, const CandidatePlane& plane,
                                         double epsilon, const SparseGrowth& config);
+
+// Grows each patch of `set` in turn (patch k split on references[k]; blocks another patch
+// grew into are no longer free): labels its new blocks, adds their surface to surfaces[k]
+// and leaves its outline to be rasterised again.
+void growPatches(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions, const PlaneScorer& scorer,
+                 const std::vector<CandidatePlane>& references, std::vector<double>& surfaces, PatchSet& set,
+                 const SparseGrowth& config);
 
 }  // namespace mlmap
