@@ -40,7 +40,7 @@ double gapBetween(const PlaneBlock& a, const PlaneBlock& b, const GrowthPlane& p
   return std::hypot(std::hypot(step.x(), step.y()), vertical);
 }
 
-// Whether the cells strictly between the two blocks' show the scanner saw past the
+// Whether the cells strictly between two blocks' cells show that the scanner saw past the
 // plane there: a level plane's far side (with nothing at the plane in that cell), or a
 // wall's both sides (an opening).
 bool seenPastBetween(const BlockGrid& grid, const GrowthPlane& plane, CellIndex from, CellIndex to) {
