@@ -17,7 +17,8 @@ input point (`mlmap label`, input order). Per marked surface the table gives
   n10     the patches that hold >= 10 % of its points,
   joins   the other marked surfaces with >= 10 % of their points on that same patch,
   rms     the RMS of its points to that patch's plane (planes JSON) / to their own least-squares plane, cm;
-and per scene the points on patches outside every marked surface ("unmarked"). With --peers,
+and per scene the points on patches outside every marked surface ("unmarked"); at the end, over
+all scans, the surfaces found and the patches on no marked surface per method. With --peers,
 CGAL's efficient RANSAC (--eps 0.03 --angle 20 --min-support 500, as bench/planes_bench.py)
 runs on the same points (annotation frame) and is scored the same way. Times: mlmap's
 detection (planes JSON total_s) and build, CGAL's normals + detection.
@@ -218,10 +219,25 @@ def table(scene, annotation, results):
     return "\n".join(lines) + "\n"
 
 
-def passed(annotation, rows):
+def found_count(annotation, rows):
+    """(surfaces found, surfaces marked): >= 90 % (walls, floor, ceiling) or >= 70 % on a patch joining no other."""
     good = sum(1 for s, r in zip(annotation["surfaces"], rows)
                if r["share"] >= (0.9 if s["kind"] in ("floor", "ceiling", "wall") else 0.7) and r["joined"] == 0)
-    return f"{good} of {len(rows)}"
+    return good, len(rows)
+
+
+def passed(annotation, rows):
+    good, total = found_count(annotation, rows)
+    return f"{good} of {total}"
+
+
+def totals_table(totals):
+    """Markdown: per method, over every scene scored, the surfaces found and the patches on no marked surface."""
+    lines = ["#### all scans", "", "| | " + " | ".join(totals) + " |", "|---|" + "---|" * len(totals),
+             "| surfaces found | " + " | ".join(f"{t['found']} of {t['marked']}" for t in totals.values()) + " |",
+             "| patches on no marked surface | " + " | ".join(str(t["stray"]) for t in totals.values()) + " |",
+             "| detection s, sum | " + " | ".join(f"{t['detect_s']:.2f}" for t in totals.values()) + " |"]
+    return "\n".join(lines) + "\n"
 
 
 def picture(points, owner, labelled, out, title):
@@ -334,7 +350,7 @@ def main():
         print(f"real_data: no cgal_ransac in {a.peers}, CGAL skipped")
     features = {c: options_of(mlmap, c) for c in ("build", "label", "register")}
     cells = [float(c) for c in a.cells.split(",")]
-    report = []
+    report, totals = [], {}
     for name, scene, why in real_clouds.scenes(a.data):
         if a.only and name not in a.only.split(","):
             continue
@@ -365,6 +381,13 @@ def main():
             results["CGAL"] = dict(rows=rows, extra=extra, times=times)
             labelled["CGAL"] = labels
         text = table(scene, annotation, results)
+        for method, result in results.items():
+            found, marked = found_count(annotation, result["rows"])
+            total = totals.setdefault(method, dict(found=0, marked=0, stray=0, detect_s=0.0))
+            total["found"] += found
+            total["marked"] += marked
+            total["stray"] += result["extra"]["stray_patches"]
+            total["detect_s"] += result["times"]["detect_s"]
         scorer = os.path.join(os.path.dirname(a.data), "peers", "score.py")
         if os.path.exists(scorer):
             text += "\n" + marked_scores(name, folder, world, owner, labelled, scorer) + "\n"
@@ -377,6 +400,10 @@ def main():
             os.makedirs(a.docs, exist_ok=True)
             picture(world, owner, labelled, os.path.join(a.docs, f"real-{name}.png"),
                     f"{name}: {scene.title}; grey: no surface / no patch")
+    if totals:
+        text = totals_table(totals)
+        print(text, flush=True)
+        report.append(text)
     if report:
         os.makedirs(a.out, exist_ok=True)
         commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
