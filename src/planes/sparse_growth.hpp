@@ -18,8 +18,8 @@
 namespace mlmap {
 
 struct SparseGrowth {
-  double max_gap = 0.0;     // m, the longest step from block to block (in the plane)
-  double kappa_rad = 0.0;   // blocks with a direction join within 2 κ of the plane's normal
+  double max_gap = 0.0;       // m, the longest step from block to block (in the plane)
+  double kappa_rad = 0.0;     // blocks with a direction join within 2 κ of the plane's normal
   double max_tilt_rad = 0.0;  // only planes this close to level or to plumb grow
   double ladder_gap = 0.0;    // m: ErmsmConfig::ladder_gap, what tells a sparse wall's rungs
 };
@@ -29,7 +29,8 @@ struct SparseGrowth {
 // reaches: each within max_gap of the patch or of a block that joined, with no block seen
 // past the plane in the cells between (for a level plane, on the side away from where it
 // was seen; for a wall, on both sides within 0.3 m: an opening). `patch` ascending.
-// Returns the joined ids ascending; none for a plane tilted more than max_tilt_rad.
+// Returns the joined ids ascending; none for a plane more than max_tilt_rad from both
+// level and plumb.
 std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                         const std::vector<std::uint32_t>& candidates,
                                         const std::vector<std::uint32_t>& patch, const CandidatePlane& plane,
