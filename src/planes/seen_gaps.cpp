@@ -24,25 +24,20 @@ double heightAt(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eige
 }
 
 bool seenPast(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eigen::Vector3d& point, CellIndex from,
-              CellIndex to, double tolerance) {
-  const int steps = chebyshev(from, to);
-  for (int step = 1; step < steps; ++step) {
-    const double t = static_cast<double>(step) / steps;
-    const auto i = static_cast<std::int32_t>(std::lround(from.i + t * (to.i - from.i)));
-    const auto j = static_cast<std::int32_t>(std::lround(from.j + t * (to.j - from.j)));
-    const double height = heightAt(grid, normal, point, CellIndex{i, j});
-    bool below = false, at = false;
-    grid.forEachInCells(i, i, j, j, [&](std::uint32_t id) {
+              CellIndex to, double tolerance, FarSide far_side) {
+  return anyCellBetween(from, to, [&](CellIndex cell) {
+    const double height = heightAt(grid, normal, point, cell);
+    bool beyond = false, at = false;
+    grid.forEachInCells(cell.i, cell.i, cell.j, cell.j, [&](std::uint32_t id) {
       const PlaneBlock& block = grid.blocks()[id];
-      if (block.top < height - tolerance) {
-        below = true;
-      } else if (block.bottom <= height + tolerance) {
+      if (far_side == FarSide::Below ? block.top < height - tolerance : block.bottom > height + tolerance) {
+        beyond = true;
+      } else if (far_side == FarSide::Below ? block.bottom <= height + tolerance : block.top >= height - tolerance) {
         at = true;
       }
     });
-    if (below && !at) return true;
-  }
-  return false;
+    return beyond && !at;
+  });
 }
 
 namespace {

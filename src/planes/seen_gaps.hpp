@@ -6,6 +6,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <vector>
 
 #include "mlmap/planes/block_grid.hpp"
@@ -17,11 +21,29 @@ namespace mlmap {
 // m: the level plane's (`normal`, through `point`) height over a cell's centre.
 double heightAt(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eigen::Vector3d& point, CellIndex cell);
 
+// Calls visit(cell) for the cells strictly between `from` and `to` on the line joining
+// them, one per Chebyshev step, until it returns true; returns whether it did.
+template <typename Visit>
+bool anyCellBetween(CellIndex from, CellIndex to, Visit&& visit) {
+  const int steps = std::max(std::abs(from.i - to.i), std::abs(from.j - to.j));
+  for (int step = 1; step < steps; ++step) {
+    const double t = static_cast<double>(step) / steps;
+    const CellIndex cell{static_cast<std::int32_t>(std::lround(from.i + t * (to.i - from.i))),
+                         static_cast<std::int32_t>(std::lround(from.j + t * (to.j - from.j)))};
+    if (visit(cell)) return true;
+  }
+  return false;
+}
+
+// Which side of a level plane lies past it, away from the scanner: below a surface seen
+// from above (a floor, a table), above one seen from below (a ceiling).
+enum class FarSide { Below, Above };
+
 // Whether the scanner saw past the level plane (`normal`, through `point`) on the cells
 // strictly between `from` and `to`: one of them holds a block more than `tolerance`
-// under the plane and none at the plane.
+// beyond the plane on its far side and none at the plane.
 bool seenPast(const BlockGrid& grid, const Eigen::Vector3d& normal, const Eigen::Vector3d& point, CellIndex from,
-              CellIndex to, double tolerance);
+              CellIndex to, double tolerance, FarSide far_side = FarSide::Below);
 
 // Whether most of the blocks' cells hold map surface above the plane: a table under a
 // ceiling. What lies past a level surface is on the far side from the scanner, which

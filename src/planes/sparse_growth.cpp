@@ -41,38 +41,22 @@ double gapBetween(const PlaneBlock& a, const PlaneBlock& b, const GrowthPlane& p
 }
 
 // Whether the cells strictly between two blocks' cells show that the scanner saw past the
-// plane there: a level plane's far side (with nothing at the plane in that cell), or a
-// wall's both sides (an opening).
+// plane there: a level plane's far side (seenPast), or a wall's both sides (an opening).
 bool seenPastBetween(const BlockGrid& grid, const GrowthPlane& plane, CellIndex from, CellIndex to) {
-  const int steps = std::max(std::abs(from.i - to.i), std::abs(from.j - to.j));
+  if (plane.level) {
+    return seenPast(grid, plane.normal, plane.point, from, to, plane.epsilon,
+                    plane.seen_from_above ? FarSide::Below : FarSide::Above);
+  }
   bool front = false;
   bool behind = false;
-  for (int step = 1; step < steps; ++step) {
-    const double t = static_cast<double>(step) / steps;
-    const CellIndex cell{static_cast<std::int32_t>(std::lround(from.i + t * (to.i - from.i))),
-                         static_cast<std::int32_t>(std::lround(from.j + t * (to.j - from.j)))};
-    if (plane.level) {
-      const double height = heightAt(grid, plane.normal, plane.point, cell);
-      bool beyond = false, at = false;
-      grid.forEachInCells(cell.i, cell.i, cell.j, cell.j, [&](std::uint32_t id) {
-        const PlaneBlock& block = grid.blocks()[id];
-        if (plane.seen_from_above ? block.top < height - plane.epsilon : block.bottom > height + plane.epsilon) {
-          beyond = true;
-        } else if (block.bottom <= height + plane.epsilon && block.top >= height - plane.epsilon) {
-          at = true;
-        }
-      });
-      if (beyond && !at) return true;
-      continue;
-    }
+  return anyCellBetween(from, to, [&](CellIndex cell) {
     grid.forEachInCells(cell.i, cell.i, cell.j, cell.j, [&](std::uint32_t id) {
       const double distance = plane.normal.dot(grid.blocks()[id].point.cast<double>() - plane.point);
       if (std::abs(distance) <= plane.epsilon || std::abs(distance) > kOpeningReach) return;
       (distance > 0.0 ? front : behind) = true;
     });
-    if (front && behind) return true;
-  }
-  return false;
+    return front && behind;
+  });
 }
 
 }  // namespace
