@@ -2,9 +2,13 @@
 // sampled densely on rectangles with a little noise and inserted into an MLMap.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <random>
+#include <vector>
 
 #include "mlmap/map/ml_map.hpp"
+#include "mlmap/planes/ermsm.hpp"
 
 namespace mlmap::test {
 
@@ -55,5 +59,16 @@ class PlaneSceneBuilder {
   std::normal_distribution<double> noise_;
   std::mt19937 random_;
 };
+
+// The level patches (normal within 18° of vertical) whose centroid lies within 3 cm of
+// `height`, largest first.
+inline std::vector<const Plane*> levelPatchesAt(const PlaneDetection& detection, double height) {
+  std::vector<const Plane*> found;
+  for (const Plane& plane : detection.planes) {
+    if (std::abs(plane.normal.z()) > 0.95 && std::abs(plane.centroid.z() - height) < 0.03) found.push_back(&plane);
+  }
+  std::sort(found.begin(), found.end(), [](const Plane* a, const Plane* b) { return a->area > b->area; });
+  return found;
+}
 
 }  // namespace mlmap::test

@@ -12,20 +12,6 @@
 
 using namespace mlmap;
 
-namespace {
-
-// The level patches whose centroid lies within 3 cm of `height`, largest first.
-std::vector<const Plane*> levelAt(const PlaneDetection& detection, double height) {
-  std::vector<const Plane*> found;
-  for (const Plane& plane : detection.planes) {
-    if (std::abs(plane.normal.z()) > 0.95 && std::abs(plane.centroid.z() - height) < 0.03) found.push_back(&plane);
-  }
-  std::sort(found.begin(), found.end(), [](const Plane* a, const Plane* b) { return a->area > b->area; });
-  return found;
-}
-
-}  // namespace
-
 TEST_CASE("eRMSM: two desks 0.25 m apart at one height, the floor seen between them, are two patches") {
   for (const double cell : {0.05, 0.1}) {
     for (const unsigned seed : {1U, 2U}) {
@@ -40,7 +26,7 @@ TEST_CASE("eRMSM: two desks 0.25 m apart at one height, the floor seen between t
           .floor(1.0 + o, 1.0 + o, 2.4 + o, 1.75 + o, 0.75)
           .floor(2.65 + o, 1.0 + o, 4.05 + o, 1.75 + o, 0.75);
       const PlaneDetection detection = detectPlanes(scene.map());
-      const std::vector<const Plane*> desks = levelAt(detection, 0.75);
+      const std::vector<const Plane*> desks = test::levelPatchesAt(detection, 0.75);
       REQUIRE(desks.size() >= 2);
       // Each about its own 1.05 m², not the two together.
       CHECK(desks[0]->area < 1.5);
@@ -63,7 +49,7 @@ TEST_CASE("eRMSM: a desk whose middle strip nobody saw is one patch") {
         .floor(1.0 + o, 1.0 + o, 2.0 + o, 1.75 + o, 0.75)
         .floor(2.2 + o, 1.0 + o, 3.2 + o, 1.75 + o, 0.75);
     const PlaneDetection detection = detectPlanes(scene.map());
-    const std::vector<const Plane*> desks = levelAt(detection, 0.75);
+    const std::vector<const Plane*> desks = test::levelPatchesAt(detection, 0.75);
     REQUIRE(!desks.empty());
     CHECK(desks[0]->area > 1.3);  // both halves, 1.5 m² (and their edge cells)
   }

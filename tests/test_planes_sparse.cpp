@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "mlmap/planes/ermsm.hpp"
 #include "plane_scenes.hpp"
@@ -38,15 +39,18 @@ double shareBeyond(const MLMap& map, double x, std::int32_t id) {
   return all > 0 ? static_cast<double>(on) / static_cast<double>(all) : 0.0;
 }
 
+// The largest level patch at `height`, or none.
 const Plane* levelAt(const PlaneDetection& detection, double height) {
-  const Plane* best = nullptr;
-  for (const Plane& plane : detection.planes) {
-    if (std::abs(plane.normal.z()) > 0.95 && std::abs(plane.centroid.z() - height) < 0.03 &&
-        (best == nullptr || plane.area > best->area)) {
-      best = &plane;
-    }
-  }
-  return best;
+  const std::vector<const Plane*> found = test::levelPatchesAt(detection, height);
+  return found.empty() ? nullptr : found.front();
+}
+
+// A dense 4 x 4 m floor with a wall at its far edge's foot, and beyond it six sparse scan
+// lines 0.35-0.55 m apart on the floor's plane.
+void farFloor(test::PlaneSceneBuilder& scene, double cell, unsigned seed) {
+  const double o = cell / 3.0;  // off the cell boundaries
+  scene.withNoise(0.005, 9e-4).floor(o, o, 4.0 + o, 4.0 + o, 0.0).wallY(4.2, o, 4.0 + o, 0.0, 2.0);
+  sparseLines(scene.map(), {4.35, 4.7, 5.1, 5.55, 6.05, 6.6}, 0.0, seed);
 }
 
 }  // namespace
@@ -57,17 +61,14 @@ TEST_CASE("eRMSM: a floor's far part, sparse scan lines 0.35-0.55 m apart, is on
       CAPTURE(cell);
       CAPTURE(seed);
       test::PlaneSceneBuilder scene(cell, 0.005, seed);
-      const double o = cell / 3.0;
-      scene.withNoise(0.005, 9e-4).floor(o, o, 4.0 + o, 4.0 + o, 0.0).wallY(4.2, o, 4.0 + o, 0.0, 2.0);
-      sparseLines(scene.map(), {4.35, 4.7, 5.1, 5.55, 6.05, 6.6}, 0.0, seed);
+      farFloor(scene, cell, seed);
       const PlaneDetection detection = detectPlanes(scene.map());
       const Plane* floor = levelAt(detection, 0.0);
       REQUIRE(floor != nullptr);
       CHECK(shareBeyond(scene.map(), 4.3, floor->id) > 0.9);
       // Without the growth, the lines are on no patch (as before).
       test::PlaneSceneBuilder again(cell, 0.005, seed);
-      again.withNoise(0.005, 9e-4).floor(o, o, 4.0 + o, 4.0 + o, 0.0).wallY(4.2, o, 4.0 + o, 0.0, 2.0);
-      sparseLines(again.map(), {4.35, 4.7, 5.1, 5.55, 6.05, 6.6}, 0.0, seed);
+      farFloor(again, cell, seed);
       ErmsmConfig off;
       off.sparse_gap = 0.0;
       const PlaneDetection before = detectPlanes(again.map(), off);
