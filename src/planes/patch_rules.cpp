@@ -40,7 +40,7 @@ Sums sumInChunks(std::size_t count, [[maybe_unused]] int threads, Add add, Combi
 std::vector<std::uint32_t> withEdges(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                      const PlaneScorer& scorer, std::vector<std::uint32_t> matching,
                                      const CandidatePlane& plane, double epsilon, double kappa_rad) {
-  const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * kappa_rad, std::numbers::pi / 2)));
+  const float cos_edge = edgeCosine(kappa_rad);
   const auto reach = static_cast<float>(epsilon);
   IdSet in_plane(grid.size());
   for (const std::uint32_t id : matching) in_plane.insert(id);

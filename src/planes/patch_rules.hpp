@@ -4,8 +4,10 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <cstdint>
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <numbers>
 #include <vector>
 
 #include "mlmap/planes/block_grid.hpp"
@@ -13,6 +15,12 @@
 #include "plane_scorer.hpp"
 
 namespace mlmap {
+
+// The cosine of the widest angle an edge block's direction may make with a plane's
+// normal: 2 κ, at most 90°.
+inline float edgeCosine(double kappa_rad) {
+  return static_cast<float>(std::cos(std::min(2.0 * kappa_rad, std::numbers::pi / 2)));
+}
 
 // Blocks on the plane's edges, where a corner or a rim bends their direction vectors
 // past κ (or leaves them none), join the plane when they touch its matching blocks, lie

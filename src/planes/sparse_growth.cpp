@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "id_set.hpp"
+#include "patch_rules.hpp"
 #include "seen_gaps.hpp"
 
 namespace mlmap {
@@ -82,7 +83,7 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
     for (std::size_t k = 0; k < patch.size(); k += stride) sample.push_back(patch[k]);
     plane.seen_from_above = seenFromAbove(grid, sample, plane.normal, plane.point, epsilon);
   }
-  const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * config.kappa_rad, std::numbers::pi / 2)));
+  const float cos_edge = edgeCosine(config.kappa_rad);
   IdSet pool(grid.size());
   std::size_t pooled = 0;
   for (const std::uint32_t id : candidates) {
@@ -183,7 +184,7 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
 void growPatches(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions, const PlaneScorer& scorer,
                  const std::vector<CandidatePlane>& references, std::vector<double>& surfaces, PatchSet& set,
                  const SparseGrowth& config) {
-  const auto cos_edge = static_cast<float>(std::cos(std::min(2.0 * config.kappa_rad, std::numbers::pi / 2)));
+  const float cos_edge = edgeCosine(config.kappa_rad);
   for (std::size_t k = 0; k < set.planes.size(); ++k) {
     const CandidatePlane& reference = references[k];
     const float band = scorer.bandOf(reference);
