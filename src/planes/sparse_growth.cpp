@@ -74,25 +74,16 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
   if (std::min(tilt, std::numbers::pi / 2 - tilt) > config.max_tilt_rad) return {};
   GrowthPlane plane{reference.normal.cast<double>().normalized(), reference.point.cast<double>(), epsilon,
                     std::abs(reference.normal.z()) >= std::cos(std::numbers::pi / 4.0), false};
-  if (plane.level) {
-    // A majority over at most 4096 of its blocks, evenly spread: a floor at 2 cm has
-    // 150 000, and asking each of them cost more than the growth itself.
-    const std::size_t stride = std::max<std::size_t>(1, patch.size() / 4096);
-    std::vector<std::uint32_t> sample;
-    sample.reserve(patch.size() / stride + 1);
-    for (std::size_t k = 0; k < patch.size(); k += stride) sample.push_back(patch[k]);
-    plane.seen_from_above = seenFromAbove(grid, sample, plane.normal, plane.point, epsilon);
-  }
   const float cos_edge = edgeCosine(config.kappa_rad);
   IdSet pool(grid.size());
   std::size_t pooled = 0;
   for (const std::uint32_t id : candidates) {
     const PlaneBlock& block = grid.blocks()[id];
-    if (plane.level && block.vertical) continue;
-    // A short block with another of its cell less than a ladder gap above or below is a
-    // rung of a wall seen from afar (fr079 at 5 cm: a table's plane took 96 points of the
-    // wall beside it), not a piece of a level surface.
+    // A level plane takes level blocks only, and no short block with another of its cell
+    // less than a ladder gap above or below: that is a rung of a wall seen from afar (fr079
+    // at 5 cm: a table's plane took 96 points of the wall beside it).
     if (plane.level) {
+      if (block.vertical) continue;
       bool rung = false;
       grid.forEachInCells(block.cell.i, block.cell.i, block.cell.j, block.cell.j, [&](std::uint32_t other) {
         if (other == id) return;
@@ -108,6 +99,15 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
     ++pooled;
   }
   if (pooled == 0) return {};
+  if (plane.level) {
+    // A majority over at most 4096 of its blocks, evenly spread: a floor at 2 cm has
+    // 150 000, and asking each of them cost more than the growth itself.
+    const std::size_t stride = std::max<std::size_t>(1, patch.size() / 4096);
+    std::vector<std::uint32_t> sample;
+    sample.reserve(patch.size() / stride + 1);
+    for (std::size_t k = 0; k < patch.size(); k += stride) sample.push_back(patch[k]);
+    plane.seen_from_above = seenFromAbove(grid, sample, plane.normal, plane.point, epsilon);
+  }
   IdSet inside(grid.size());
   for (const std::uint32_t id : patch) inside.insert(id);
   // At most kMaxGap (a configuration read from a file is not bounded as the CLI's is).
