@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "voxel_blocks.hpp"
@@ -165,28 +166,38 @@ void VoxelHashMap::estimateNormals(const NormalConfig& config) {
 }
 
 double VoxelHashMap::surfaceNoise(std::size_t max_voxels) const {
-  std::vector<double> distances;
   const std::size_t stride = std::max<std::size_t>(1, table_.size() / std::max<std::size_t>(1, max_voxels));
-  for (std::size_t v = 0; v < table_.size(); v += stride) {
-    if (normals_[v].isZero()) continue;
-    const VoxelKey own = table_.key(static_cast<std::uint32_t>(v));
-    std::size_t count = 0;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();  // about this voxel's centre
-    for (const VoxelKey& offset : stencil_) {
-      const std::uint32_t index = table_.find(own + offset);
-      if (index == VoxelTable::kMissing) continue;
-      count += pointsIn(index);
-      sum += moments_[index].sum + static_cast<double>(pointsIn(index)) *
-                                       Eigen::Vector3d(offset.x, offset.y, offset.z) * voxel_size_;
+  const auto sampled = static_cast<std::int64_t>((table_.size() + stride - 1) / stride);
+  // Each thread collects its voxels' distances; the median does not depend on their order.
+  std::vector<double> distances;
+#pragma omp parallel if (sampled >= 1000)
+  {
+    std::vector<double> mine;
+#pragma omp for schedule(static) nowait
+    for (std::int64_t s = 0; s < sampled; ++s) {
+      const auto v = static_cast<std::size_t>(s) * stride;
+      if (normals_[v].isZero()) continue;
+      const VoxelKey own = table_.key(static_cast<std::uint32_t>(v));
+      std::size_t count = 0;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();  // about this voxel's centre
+      for (const VoxelKey& offset : stencil_) {
+        const std::uint32_t index = table_.find(own + offset);
+        if (index == VoxelTable::kMissing) continue;
+        count += pointsIn(index);
+        sum += moments_[index].sum + static_cast<double>(pointsIn(index)) *
+                                         Eigen::Vector3d(offset.x, offset.y, offset.z) * voxel_size_;
+      }
+      if (count <= 3) continue;
+      const Point mean = centreOf(own) + sum / static_cast<double>(count);
+      // A plane fitted to n points leaves n − 3 degrees of freedom across it: scale so the
+      // spread estimates one point's noise, not its deviation from a plane fitted through it.
+      const double dof = std::sqrt(static_cast<double>(count) / static_cast<double>(count - 3));
+      for (std::uint32_t k = begin_[v]; k < begin_[v + 1]; ++k) {
+        mine.push_back(dof * std::abs(normals_[v].dot(points_[k] - mean)));
+      }
     }
-    if (count <= 3) continue;
-    const Point mean = centreOf(own) + sum / static_cast<double>(count);
-    // A plane fitted to n points leaves n − 3 degrees of freedom across it: scale so the
-    // spread estimates one point's noise, not its deviation from a plane fitted through it.
-    const double dof = std::sqrt(static_cast<double>(count) / static_cast<double>(count - 3));
-    for (std::uint32_t k = begin_[v]; k < begin_[v + 1]; ++k) {
-      distances.push_back(dof * std::abs(normals_[v].dot(points_[k] - mean)));
-    }
+#pragma omp critical(surface_noise_distances)
+    distances.insert(distances.end(), mine.begin(), mine.end());
   }
   if (distances.empty()) return 0.0;
   auto middle = distances.begin() + static_cast<long>(distances.size() / 2);
