@@ -18,7 +18,9 @@ input point (`mlmap label`, input order). Per marked surface the table gives
   joins   the other marked surfaces with >= 10 % of their points on that same patch,
   rms     the RMS of its points to that patch's plane (planes JSON) / to their own least-squares plane, cm;
 and per scene the points on patches outside every marked surface ("unmarked"); at the end, over
-all scans, the surfaces found and the patches on no marked surface per method. With --peers,
+all scans, the surfaces found (and issue 19's split: walls, floor, ceiling >= 90 %, the others
+>= 70 %, RMS to the patch's plane within 0.5 cm of the points' own fit) and the patches on no
+marked surface per method. With --peers,
 CGAL's efficient RANSAC (--eps 0.03 --angle 20 --min-support 500, as bench/planes_bench.py)
 runs on the same points (annotation frame) and is scored the same way. Times: mlmap's
 detection (planes JSON total_s) and build, CGAL's normals + detection.
@@ -226,6 +228,20 @@ def found_count(annotation, rows):
     return good, len(rows)
 
 
+def issue_counts(annotation, rows):
+    """Issue 19's figures for one scene: walls, floor and ceiling found (>= 90 %), the other
+    surfaces found (>= 70 %), each with how many are marked, and the surfaces whose points lie
+    within 0.5 cm (RMS) of the largest patch's plane as of their own least-squares fit."""
+    counts = dict(structural_found=0, structural=0, other_found=0, other=0, rms_ok=0)
+    for surface, row in zip(annotation["surfaces"], rows):
+        structural = surface["kind"] in ("floor", "ceiling", "wall")
+        key = "structural" if structural else "other"
+        counts[key] += 1
+        counts[key + "_found"] += int(row["share"] >= (0.9 if structural else 0.7) and row["joined"] == 0)
+        counts["rms_ok"] += int(row["n10"] > 0 and not math.isnan(row["rms"]) and row["rms"] - row["own"] <= 0.005)
+    return counts
+
+
 def passed(annotation, rows):
     good, total = found_count(annotation, rows)
     return f"{good} of {total}"
@@ -235,6 +251,12 @@ def totals_table(totals):
     """Markdown: per method, over every scene scored, the surfaces found and the patches on no marked surface."""
     lines = ["#### all scans", "", "| | " + " | ".join(totals) + " |", "|---|" + "---|" * len(totals),
              "| surfaces found | " + " | ".join(f"{t['found']} of {t['marked']}" for t in totals.values()) + " |",
+             "| walls, floor, ceiling: >= 90 % on a patch joining no other | " + " | ".join(
+                 f"{t['structural_found']} of {t['structural']}" for t in totals.values()) + " |",
+             "| the others (tables, treads, steps): >= 70 % | " + " | ".join(
+                 f"{t['other_found']} of {t['other']}" for t in totals.values()) + " |",
+             "| RMS to the patch's plane within 0.5 cm of the points' own fit | " + " | ".join(
+                 f"{t['rms_ok']} of {t['marked']}" for t in totals.values()) + " |",
              "| patches on no marked surface | " + " | ".join(str(t["stray"]) for t in totals.values()) + " |",
              "| detection s, sum | " + " | ".join(f"{t['detect_s']:.2f}" for t in totals.values()) + " |"]
     return "\n".join(lines) + "\n"
@@ -383,9 +405,12 @@ def main():
         text = table(scene, annotation, results)
         for method, result in results.items():
             found, marked = found_count(annotation, result["rows"])
-            total = totals.setdefault(method, dict(found=0, marked=0, stray=0, detect_s=0.0))
+            total = totals.setdefault(method, dict(found=0, marked=0, stray=0, detect_s=0.0, structural_found=0,
+                                                   structural=0, other_found=0, other=0, rms_ok=0))
             total["found"] += found
             total["marked"] += marked
+            for key, count in issue_counts(annotation, result["rows"]).items():
+                total[key] += count
             total["stray"] += result["extra"]["stray_patches"]
             total["detect_s"] += result["times"]["detect_s"]
         scorer = os.path.join(os.path.dirname(a.data), "peers", "score.py")
