@@ -5,11 +5,16 @@
 #include <cmath>
 #include <string>
 #include <numbers>
+#include <vector>
 
 #include "mlmap/registration/preprocessing.hpp"
 #include "mlmap/registration/verified_icp.hpp"
 #include "mlmap/sim/scene.hpp"
 #include "mlmap/sim/simulator.hpp"
+
+#ifdef MLMAP_HAVE_OPENMP
+#include <omp.h>
+#endif
 
 namespace {
 
@@ -297,3 +302,27 @@ TEST_CASE("alignVerified: along a long corridor the points facing its axis fit i
   CHECK(translationError(result.icp.pose, corridor.true_pose) < 0.01);
   CHECK(rotationErrorDeg(result.icp.pose, corridor.true_pose) < 0.1);
 }
+
+#ifdef MLMAP_HAVE_OPENMP
+TEST_CASE("alignVerified: the same answer at 1 and 2 threads") {
+  // Its checks run on all threads (the slide profile's shifts, the source's normals, the
+  // target's noise sample): each count, normal and median must not depend on the team.
+  const Pair pair = simulatedPair(kSymmetricRoomJson);
+  const Pose start = startOff(pair.true_pose, {0.45, -0.3, 0.0}, 25.0);
+  const int threads = omp_get_max_threads();
+  std::vector<VerifiedIcp> runs;
+  for (const int count : {1, 2}) {
+    omp_set_num_threads(count);
+    runs.push_back(alignVerified(pair.source, pair.target, start));
+  }
+  omp_set_num_threads(threads);
+  CHECK(runs[0].icp.pose.matrix() == runs[1].icp.pose.matrix());
+  CHECK(runs[0].attempts == runs[1].attempts);
+  CHECK(runs[0].noise == runs[1].noise);
+  CHECK(runs[0].source_noise == runs[1].source_noise);
+  CHECK(runs[0].check.profile.at_result == runs[1].check.profile.at_result);
+  CHECK(runs[0].check.profile.away == runs[1].check.profile.away);
+  CHECK(runs[0].check.profile.best == runs[1].check.profile.best);
+  CHECK(runs[0].verified);
+}
+#endif
