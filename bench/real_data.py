@@ -221,11 +221,6 @@ def table(scene, annotation, results):
     return "\n".join(lines) + "\n"
 
 
-def found_count(annotation, rows):
-    """(surfaces found, surfaces marked): >= 90 % (walls, floor, ceiling) or >= 70 % on a patch joining no other."""
-    good = sum(1 for s, r in zip(annotation["surfaces"], rows)
-               if r["share"] >= (0.9 if s["kind"] in ("floor", "ceiling", "wall") else 0.7) and r["joined"] == 0)
-    return good, len(rows)
 
 
 def issue_counts(annotation, rows):
@@ -240,6 +235,12 @@ def issue_counts(annotation, rows):
         counts[key + "_found"] += int(row["share"] >= (0.9 if structural else 0.7) and row["joined"] == 0)
         counts["rms_ok"] += int(row["n10"] > 0 and not math.isnan(row["rms"]) and row["rms"] - row["own"] <= 0.005)
     return counts
+
+
+def found_count(annotation, rows):
+    """(surfaces found, surfaces marked): >= 90 % (walls, floor, ceiling) or >= 70 % on a patch joining no other."""
+    counts = issue_counts(annotation, rows)
+    return counts["structural_found"] + counts["other_found"], len(rows)
 
 
 def passed(annotation, rows):

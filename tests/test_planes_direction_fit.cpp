@@ -18,6 +18,7 @@ namespace {
 
 constexpr double kKappa = 25.0 * std::numbers::pi / 180.0;
 constexpr double kEpsilon = 0.05;
+constexpr double kPlumbTilt = 15.0 * std::numbers::pi / 180.0;  // ClassifyConfig's walls, as the detector passes
 
 double angleDeg(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
   return std::acos(std::min(1.0F, std::abs(a.normalized().dot(b.normalized())))) * 180.0 / std::numbers::pi;
@@ -55,7 +56,7 @@ TEST_CASE("Direction fit: a plane leaning between a wall and a proud panel is tu
     const CandidatePlane leaning = planeThrough(Eigen::Vector3f(0.035F, 1.0F, 0.0F), Eigen::Vector3f(2.5F, 0.0F, 1.0F));
     const std::vector<std::uint32_t> strict = scorer.matching(leaning);
     REQUIRE(strict.size() > 30);
-    const std::optional<CandidatePlane> turned = alongDirections(grid, directions, scorer, strict, leaning);
+    const std::optional<CandidatePlane> turned = alongDirections(grid, directions, scorer, strict, leaning, kPlumbTilt);
     REQUIRE(turned.has_value());
     CHECK(angleDeg(turned->normal, Eigen::Vector3f::UnitY()) < 0.3);
     // On the wall, the layer of most surface, not between it and the panel.
@@ -70,9 +71,9 @@ TEST_CASE("Direction fit: planes whose blocks agree with them, and level planes,
   const PlaneScorer scorer(grid, directions, kEpsilon, kKappa);
   // The wall's own plane.
   const CandidatePlane wall = planeThrough(Eigen::Vector3f::UnitY(), Eigen::Vector3f(2.5F, 0.0F, 1.0F));
-  CHECK_FALSE(alongDirections(grid, directions, scorer, scorer.matching(wall), wall).has_value());
+  CHECK_FALSE(alongDirections(grid, directions, scorer, scorer.matching(wall), wall, kPlumbTilt).has_value());
   // A floor plane leaning 2°: level planes are left to the level rules (what lies on a
   // table turns its blocks' windows).
   const CandidatePlane floor = planeThrough(Eigen::Vector3f(0.035F, 0.0F, 1.0F), Eigen::Vector3f(3.0F, -1.5F, 0.0F));
-  CHECK_FALSE(alongDirections(grid, directions, scorer, scorer.matching(floor), floor).has_value());
+  CHECK_FALSE(alongDirections(grid, directions, scorer, scorer.matching(floor), floor, kPlumbTilt).has_value());
 }

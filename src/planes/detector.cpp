@@ -247,19 +247,18 @@ bool Detector::accept(std::size_t index) {
   // candidate with them cost patches and a third of the search's time).
   CandidatePlane cut = accepted.plane;
   std::vector<std::uint32_t> strict = scorer_.matching(cut);
-  if (const std::optional<CandidatePlane> turned = alongDirections(grid_, directions_, scorer_, strict, cut)) {
-    std::vector<std::uint32_t> turned_strict = scorer_.matching(*turned);
-    if (!refuses(*turned, turned_strict)) {
-      cut = *turned;
-      strict = std::move(turned_strict);
-    }
-  }
-  const bool level = std::abs(cut.normal.z()) >= std::cos(radians(45.0));
-  if (refuses(cut, strict)) {
+  const double plumb_tilt = radians(ClassifyConfig{}.horizontal_deg);  // the walls' class, as the sparse growth's
+  const std::optional<CandidatePlane> turned = alongDirections(grid_, directions_, scorer_, strict, cut, plumb_tilt);
+  std::vector<std::uint32_t> turned_strict = turned ? scorer_.matching(*turned) : std::vector<std::uint32_t>{};
+  if (turned && !refuses(*turned, turned_strict)) {
+    cut = *turned;
+    strict = std::move(turned_strict);
+  } else if (refuses(cut, strict)) {
     refused_.push_back(accepted.plane);
     drop(index);
     return false;
   }
+  const bool level = std::abs(cut.normal.z()) >= std::cos(radians(45.0));
   const std::vector<std::uint32_t> matching =
       withEdges(grid_, directions_, scorer_, strict, cut, scorer_.bandOf(cut), kappa);
   const double cell_area = grid_.cellSize() * grid_.cellSize();

@@ -12,21 +12,17 @@ namespace {
 // turned room_scan2's walls too, and lost Bobkov's wall x4.72 at 5 cm cells, 93 -> 69 %:
 // a bent wall, two faces 7° apart; 6 left room_scan2's leaning plane, 4.3 standard errors)
 constexpr double kTurnStandardErrors = 4.0;
-// ... and at least this far (degrees): turns under it move a 5 m wall's ends by less than
-// 4.4 cm, inside ε, and the fit's lean is then no loss.
-constexpr double kMinTurnDeg = 1.0;
-// Plumb: the normal within this of horizontal (ClassifyConfig's walls).
-constexpr double kPlumbDeg = 15.0;
-
-double radiansOf(double degrees) { return degrees * std::numbers::pi / 180.0; }
+// ... and at least this far (1°, in radians): turns under it move a 5 m wall's ends by less
+// than 4.4 cm, inside ε, and the fit's lean is then no loss.
+constexpr double kMinTurn = std::numbers::pi / 180.0;
 
 }  // namespace
 
 std::optional<CandidatePlane> alongDirections(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                               const PlaneScorer& scorer, const std::vector<std::uint32_t>& strict,
-                                              const CandidatePlane& plane) {
+                                              const CandidatePlane& plane, double max_tilt_rad) {
   const Eigen::Vector3d normal = plane.normal.cast<double>();
-  if (std::abs(normal.z()) > std::sin(radiansOf(kPlumbDeg))) return std::nullopt;
+  if (std::abs(normal.z()) > std::sin(max_tilt_rad)) return std::nullopt;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   double weight = 0.0, weight_sq = 0.0, sine_sq = 0.0;
   for (const std::uint32_t id : strict) {
@@ -45,7 +41,7 @@ std::optional<CandidatePlane> alongDirections(const BlockGrid& grid, const std::
   // The standard error of the mean direction: the blocks' RMS angle from the normal over the
   // root of their effective number (surface-weighted).
   const double standard_error = std::sqrt(sine_sq / weight) / std::sqrt(weight * weight / weight_sq);
-  if (turn < std::max(radiansOf(kMinTurnDeg), kTurnStandardErrors * standard_error)) return std::nullopt;
+  if (turn < std::max(kMinTurn, kTurnStandardErrors * standard_error)) return std::nullopt;
 
   std::vector<std::pair<double, double>> offsets;  // (offset along the mean direction, surface)
   offsets.reserve(strict.size());

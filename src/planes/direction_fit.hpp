@@ -21,13 +21,13 @@
 
 namespace mlmap {
 
-// For a plumb plane (within 15° of vertical: walls; level planes' blocks turn with what lies
-// on them) whose matching blocks `strict` have a mean direction further from its normal than
-// kTurnStandardErrors standard errors of that mean and kMinTurnDeg: the plane along that
-// direction through the layer of those blocks that holds the most surface (the ε-wide window
-// of their offsets along it). None otherwise.
+// For a plumb plane (its normal within `max_tilt_rad` of horizontal: walls; level planes'
+// blocks turn with what lies on them) whose matching blocks `strict` have a mean direction
+// further from its normal than kTurnStandardErrors standard errors of that mean and kMinTurn:
+// the plane along that direction through the layer of those blocks that holds the most
+// surface (the ε-wide window of their offsets along it). None otherwise.
 std::optional<CandidatePlane> alongDirections(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                               const PlaneScorer& scorer, const std::vector<std::uint32_t>& strict,
-                                              const CandidatePlane& plane);
+                                              const CandidatePlane& plane, double max_tilt_rad);
 
 }  // namespace mlmap
