@@ -54,3 +54,44 @@ TEST_CASE("eRMSM: a desk whose middle strip nobody saw is one patch") {
     CHECK(desks[0]->area > 1.3);  // both halves, 1.5 m² (and their edge cells)
   }
 }
+
+// A wall's pieces either side of a doorway (issue 19; 3DTK's hall wall: two patches either
+// side of doorways 0.45 and 0.6 m wide whose lintels the scan did not reach) are one wall;
+// two walls in line with a room's width between them stay two.
+TEST_CASE("eRMSM: a wall's pieces either side of a doorway are one patch, walls 2 m apart in line are two") {
+  const auto wallsAt = [](const PlaneDetection& detection) {
+    std::vector<const Plane*> walls;
+    for (const Plane& plane : detection.planes) {
+      if (std::abs(plane.normal.y()) > 0.97 && std::abs(plane.offset + 2.0 * plane.normal.y()) < 0.05) {
+        walls.push_back(&plane);
+      }
+    }
+    return walls;
+  };
+  for (const double cell : {0.05, 0.1}) {
+    for (const unsigned seed : {1U, 2U}) {
+      CAPTURE(cell);
+      CAPTURE(seed);
+      const double o = cell / 3.0;
+      for (const double gap : {0.7, 2.0}) {
+        CAPTURE(gap);
+        test::PlaneSceneBuilder scene(cell, 0.01, seed);
+        // The wall y = 2 from x 0 to 7 with an opening `gap` wide at x 3, full height
+        // (its lintel unseen), the floor seen through it beyond the wall.
+        scene.withNoise(0.01, 9e-4)
+            .floor(o, o, 7.0 + o, 2.0 + o, 0.0)
+            .floor(3.0 + o, 2.0 + o, 3.0 + gap + o, 3.0 + o, 0.0)
+            .wallY(2.0 + o, o, 3.0 + o, 0.0, 2.4)
+            .wallY(2.0 + o, 3.0 + gap + o, 7.0 + o, 0.0, 2.4);
+        const std::vector<const Plane*> walls = wallsAt(detectPlanes(scene.map()));
+        REQUIRE(!walls.empty());
+        if (gap < 1.0) {
+          CHECK(walls.size() == 1);
+          CHECK(walls[0]->area > 0.9 * (7.0 - gap) * 2.4);
+        } else {
+          CHECK(walls.size() == 2);
+        }
+      }
+    }
+  }
+}
