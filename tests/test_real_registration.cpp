@@ -1,11 +1,15 @@
 // Registration on real scans nobody here made (issue 20): PCL's two scans of one room, from
-// the odometry start PCL's NDT tutorial gives. Skipped where ../shared/data is absent.
+// the odometry start PCL's NDT tutorial gives, scan to scan and map to map. Skipped where
+// ../shared/data is absent.
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <fstream>
 #include <numbers>
+#include <sstream>
 
+#include "cli_runner.hpp"
 #include "helpers.hpp"
 #include "mlmap/io/pcd.hpp"
 #include "mlmap/registration/sequence_registration.hpp"
@@ -83,4 +87,53 @@ TEST_CASE("Real scans: PCL's room_scan2 registers onto room_scan1 from PCL's odo
     CHECK(metres < 0.02);
     CHECK(degrees < 0.3);
   }
+}
+
+TEST_CASE("Real scans: PCL's two room maps, each levelled by calibrate, merge by registration") {
+  // Each scan is 1-2° off level; maps built from them as they are match 1.5° apart and the
+  // merge refuses (ML maps are gravity-aligned) saying how to level them. Levelled, the
+  // registration finds the transform Open3D and PCL find between the scans.
+  const auto data = mlmap::test::sharedDataDir();
+  if (!data) {
+    MESSAGE("skipped: no shared data directory");
+    return;
+  }
+  mlmap::test::TempDir dir;
+  const auto path = [&](const std::string& name) { return (dir / name).string(); };
+  for (const int k : {1, 2}) {
+    const std::string scan = (*data / "pcl_room_scans" / ("room_scan" + std::to_string(k) + ".pcd")).string();
+    const std::string tag = std::to_string(k);
+    auto result = mlmap::test::runCli("--quiet build --cell-size 0.05 --no-octree -o " + path("raw" + tag + ".mlmap") + " " + scan);
+    REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+    result = mlmap::test::runCli("--quiet calibrate -o " + path("tilt" + tag + ".json") + " " + scan);
+    REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+    result = mlmap::test::runCli("--quiet build --cell-size 0.05 --no-octree --mount " + path("tilt" + tag + ".json") +
+                                 " -o " + path("level" + tag + ".mlmap") + " " + scan);
+    REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  }
+  mlmap::test::writeText(dir / "initial.txt", "1.79387 0.720047 0 39.712\n");  // PCL's odometry start
+  const std::string merge = "--quiet merge --register --initial " + path("initial.txt") + " ";
+  const auto refused = mlmap::test::runCli(merge + path("raw1.mlmap") + " " + path("raw2.mlmap") + " -o " + path("raw.mlmap"));
+  CHECK(refused.exit_code != 0);
+  CHECK(mlmap::test::contains(refused.output, "mlmap calibrate"));
+  const auto merged = mlmap::test::runCli(merge + path("level1.mlmap") + " " + path("level2.mlmap") + " -o " +
+                                          path("level.mlmap") + " --write-transform " + path("transform.txt"));
+  REQUIRE_MESSAGE(merged.exit_code == 0, merged.output);
+  std::ifstream file(dir / "transform.txt");
+  std::string line;
+  std::getline(file, line);  // the comment
+  Eigen::Matrix4d m;
+  for (int r = 0; r < 4; ++r) {
+    std::getline(file, line);
+    std::istringstream row(line);
+    for (int c = 0; c < 4; ++c) row >> m(r, c);
+  }
+  // Levelling turns each map about its sensor, which stays at the origin: the sensors'
+  // offset and the yaw compare with the scans' transform.
+  const mlmap::Pose reference = readmeTransform();
+  CHECK(std::hypot(m(0, 3) - reference.translation().x(), m(1, 3) - reference.translation().y()) < 0.02);
+  const double yaw = std::atan2(m(1, 0), m(0, 0)) * 180.0 / std::numbers::pi;
+  const double reference_yaw =
+      std::atan2(reference.linear()(1, 0), reference.linear()(0, 0)) * 180.0 / std::numbers::pi;
+  CHECK(std::abs(yaw - reference_yaw) < 0.3);
 }

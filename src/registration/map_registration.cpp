@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "mlmap/map/ml_map.hpp"
@@ -141,8 +142,14 @@ MapRegistration registerMaps(const Map& base, const Map& other, const Pose& init
   } else if (!verified.verified) {
     registration.reason = verified.reason;
   } else if (registration.tilt_deg > config.max_tilt_deg) {
-    registration.reason = "the match tilts the other map by " + std::to_string(registration.tilt_deg) +
-                          " deg: the maps are gravity-aligned (limit " + std::to_string(config.max_tilt_deg) + " deg)";
+    // PCL's two room scans, each 1-2° off level, match 1.5° apart: the scans, not the
+    // match, need levelling.
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "the match tilts the other map by %.2f deg: the maps are gravity-aligned (limit %.2f deg); "
+                  "scans not level build tilted maps: level them (mlmap calibrate, then --mount)",
+                  registration.tilt_deg, config.max_tilt_deg);
+    registration.reason = text;
   } else if (!result.converged) {
     registration.reason = "ICP did not converge";
   }
