@@ -83,7 +83,8 @@ TEST_CASE("eRMSM: a wall's pieces either side of a doorway are one patch, walls 
             .floor(3.0 + o, 2.0 + o, 3.0 + gap + o, 3.0 + o, 0.0)
             .wallY(2.0 + o, o, 3.0 + o, 0.0, 2.4)
             .wallY(2.0 + o, 3.0 + gap + o, 7.0 + o, 0.0, 2.4);
-        const std::vector<const Plane*> walls = wallsAt(detectPlanes(scene.map()));
+        const PlaneDetection detection = detectPlanes(scene.map());
+        const std::vector<const Plane*> walls = wallsAt(detection);
         REQUIRE(!walls.empty());
         if (gap < 1.0) {
           CHECK(walls.size() == 1);
