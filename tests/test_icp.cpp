@@ -10,6 +10,10 @@
 #include "mlmap/sim/scene.hpp"
 #include "mlmap/sim/simulator.hpp"
 
+#ifdef MLMAP_HAVE_OPENMP
+#include <omp.h>
+#endif
+
 namespace {
 
 using mlmap::Point;
@@ -155,3 +159,26 @@ TEST_CASE("ICP: empty input gives an unreliable identity-free result, increments
   CHECK(incrementOf(moved, pivot).isApprox(increment, 1e-12));
   CHECK((moved * pivot - (pivot + increment.tail<3>())).norm() < 1e-12);  // the pivot only translates
 }
+
+#ifdef MLMAP_HAVE_OPENMP
+TEST_CASE("ICP: the coarse stage's passes run on all threads, the same answer at 1 and 2 threads") {
+  // A wide first gate, as the verified ICP's wide basin runs: the coarse stage searches a
+  // sparse subset of the source (over kParallelSearches points, so on the team), and its
+  // normal equations are summed in fixed blocks, whatever the number of threads.
+  const Pair pair = simulatedPair(kRoomJson);
+  REQUIRE(pair.source.size() >= 3000);  // a stride of 2 or more: a sparse coarse stage
+  const Pose start = perturbed(pair.true_pose, {0.3, -0.2, 0.0}, {0, 0, 1}, 20.0);
+  const IcpConfig config{.initial_max_distance = 1.5};
+  const int threads = omp_get_max_threads();
+  std::vector<IcpResult> runs;
+  for (const int count : {1, 2}) {
+    omp_set_num_threads(count);
+    runs.push_back(alignPoints(pair.source, pair.target, start, config));
+  }
+  omp_set_num_threads(threads);
+  CHECK(runs[0].pose.matrix() == runs[1].pose.matrix());
+  CHECK(runs[0].iterations == runs[1].iterations);
+  CHECK(runs[0].inliers == runs[1].inliers);
+  CHECK(runs[0].rms_residual == runs[1].rms_residual);
+}
+#endif
