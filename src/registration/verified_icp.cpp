@@ -286,6 +286,7 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
     if (first.constrained) constrained_results.push_back(first_pose);
     for (const Pose& from : starts) {
       const Verification check = attempt(from, wide);
+      const Pose result_pose = last_pose;  // before a slide's run
       if (verifiedCheck(check) || verifiedCheck(slide(check, wide))) break;
       // Two starts that end at one constrained result have found the answer the retries
       // can find: where nothing verifies (real scans, whose residuals the within-scan noise
@@ -293,10 +294,10 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
       // now, the same poses; the simulated stress splits and sequences: the same results.
       if (check.constrained) {
         const bool agrees = std::any_of(constrained_results.begin(), constrained_results.end(), [&](const Pose& pose) {
-          return distanceFrom(pose, last_pose, radius) < bound;
+          return distanceFrom(pose, result_pose, radius) < bound;
         });
         if (agrees) break;
-        constrained_results.push_back(last_pose);
+        constrained_results.push_back(result_pose);
       }
     }
   }
