@@ -20,12 +20,15 @@ struct BuildOptions {
   bool no_octree = false;
   double range_sigma = 0.0;
   bool register_scans = false;  // correct the poses by ICP before building
+  double scan_noise = 0.0;      // m, for --register: 0 = measured within each scan
 };
 
 // --register: one pass over the scans for scan-to-map ICP and the pose graph, from the
 // given poses (odometry) or each scan's own; returns one corrected world pose per scan.
 std::vector<io::StampedPose> registeredPoses(const BuildOptions& options, const ScanReading& reading, bool quiet) {
-  registration::SequenceRegistration sequence;
+  registration::SequenceConfig config;
+  if (options.scan_noise > 0.0) config.basin.noise = config.basin.source_noise = options.scan_noise;
+  registration::SequenceRegistration sequence(config);
   std::vector<io::StampedPose> corrected;
   const std::vector<io::StampedPose>& given = reading.sequence().poses();
   Progress progress("register", options.input.scans.size(), !quiet);
@@ -96,9 +99,14 @@ void addBuildCommand(CLI::App& app, Context& context) {
   addNumber(command, "--range-sigma", options->range_sigma,
             "Range noise of scans that carry no per-point variance, m (default: the UTM-30LX's 0.03)", 0.0,
             Bound::Open);
-  command->add_flag("--register", options->register_scans,
+  auto* register_flag = command->add_flag("--register", options->register_scans,
                     "Correct the poses (--poses as odometry, else each scan's own) by scan-to-map ICP "
                     "and a pose graph first, as `mlmap register` does");
+  addNumber(command, "--scan-noise", options->scan_noise,
+            "With --register: how far each scan's surfaces lie from where another scan sees them, m "
+            "(as `mlmap register --scan-noise`; default: measured within each scan)",
+            0.0, Bound::Open)
+      ->needs(register_flag);
   addScanOptions(command, options->input,
                  {.poses_help = "TUM pose file, one pose per scan in order (scan i in the sensor frame, pose i "
                                 "maps it to the world); without it each scan's own pose (PCD VIEWPOINT, 3DTK "

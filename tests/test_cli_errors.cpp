@@ -103,6 +103,8 @@ TEST_CASE("CLI errors: numbers parse with a plain message and the paper's parame
   checkOneLineError(runCli("planes " + room.map + " --radius 1.5"), "--radius: '1.5' is not a whole number");
   checkOneLineError(runCli("register -o " + (room.dir / "poses.tum").string() + " --scan-noise 0 " + room.scan),
                     "--scan-noise: 0 is not in (0, ");
+  checkOneLineError(runCli("build --identity --scan-noise 0.01 -o " + room.map + " " + room.scan),
+                    "--scan-noise requires --register");
 }
 
 TEST_CASE("CLI errors: pose counts and the output are checked before the long work") {
