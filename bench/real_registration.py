@@ -25,6 +25,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import real_clouds  # noqa: E402
+from icp_stress import errors, read_tum  # noqa: E402
+from merge_register import write_tum  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -43,49 +45,6 @@ def pose_matrix(r, t):
     m = np.eye(4)
     m[:3, :3], m[:3, 3] = r, t
     return m
-
-
-def quaternion(r):
-    """(x, y, z, w) of a rotation matrix."""
-    w = math.sqrt(max(0.0, 1.0 + np.trace(r))) / 2.0
-    if w > 1e-6:
-        return np.array([(r[2, 1] - r[1, 2]) / (4 * w), (r[0, 2] - r[2, 0]) / (4 * w), (r[1, 0] - r[0, 1]) / (4 * w), w])
-    k = int(np.argmax(np.diag(r)))
-    i, j = (k + 1) % 3, (k + 2) % 3
-    q = np.zeros(4)
-    q[k] = math.sqrt(max(0.0, 1.0 + r[k, k] - r[i, i] - r[j, j])) / 2.0
-    q[i] = (r[i, k] + r[k, i]) / (4 * q[k])
-    q[j] = (r[j, k] + r[k, j]) / (4 * q[k])
-    q[3] = (r[j, i] - r[i, j]) / (4 * q[k])
-    return q
-
-
-def write_tum(path, poses):
-    with open(path, "w") as out:
-        for k, m in enumerate(poses):
-            q = quaternion(m[:3, :3])
-            out.write(f"{k} {m[0, 3]:.6f} {m[1, 3]:.6f} {m[2, 3]:.6f} {q[0]:.9f} {q[1]:.9f} {q[2]:.9f} {q[3]:.9f}\n")
-
-
-def read_tum(path):
-    poses = []
-    for line in open(path):
-        if line.startswith("#") or not line.strip():
-            continue
-        v = [float(x) for x in line.split()]
-        x, y, z, w = v[4:8]
-        r = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                      [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-        poses.append(pose_matrix(r, v[1:4]))
-    return poses
-
-
-def difference(a, b):
-    """Translation (cm) and rotation (deg) between two relative poses."""
-    e = np.linalg.inv(a) @ b
-    angle = math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(e[:3, :3]) - 1.0) / 2.0))))
-    return 100.0 * np.linalg.norm(e[:3, 3]), angle
 
 
 def describe(m):
@@ -227,7 +186,7 @@ def main():
             agreement = []
             for x in range(len(names)):
                 for y in range(x + 1, len(names)):
-                    cm, deg = difference(results[names[x]], results[names[y]])
+                    cm, deg = errors(results[names[x]], results[names[y]])
                     agreement.append(f"{names[x]} / {names[y]} {cm:.1f} cm, {deg:.2f}°")
             print(f"- pair {i}-{j}, between the results: " + "; ".join(agreement) + "\n")
     return 0
