@@ -137,3 +137,34 @@ TEST_CASE("Real scans: PCL's two room maps, each levelled by calibrate, merge by
       std::atan2(reference.linear()(1, 0), reference.linear()(0, 0)) * 180.0 / std::numbers::pi;
   CHECK(std::abs(yaw - reference_yaw) < 0.3);
 }
+
+TEST_CASE("Real scans: register says what to do when the scans disagree by more than their own noise") {
+  // The CLI on PCL's pair from PCL's start: the transform is right but not verified (above);
+  // the user is told about --scan-noise, and with it the scan verifies and nothing is said.
+  const auto data = mlmap::test::sharedDataDir();
+  if (!data) {
+    MESSAGE("skipped: no shared data directory");
+    return;
+  }
+  mlmap::test::TempDir dir;
+  const std::string poses = (dir / "start.tum").string();
+  {
+    std::ofstream out(poses);
+    const Eigen::Quaterniond q(ndtStart().linear());
+    const Eigen::Vector3d t = ndtStart().translation();
+    out << "0 0 0 0 0 0 0 1\n1 " << t.x() << ' ' << t.y() << ' ' << t.z() << ' ' << q.x() << ' ' << q.y() << ' '
+        << q.z() << ' ' << q.w() << '\n';
+  }
+  const std::string scans = ((*data / "pcl_room_scans" / "room_scan1.pcd").string() + " " +
+                             (*data / "pcl_room_scans" / "room_scan2.pcd").string());
+  const std::string command = "--quiet register --no-refine --poses " + poses + " " + scans + " -o ";
+  const auto measured = mlmap::test::runCli(command + (dir / "measured.tum").string());
+  REQUIRE_MESSAGE(measured.exit_code == 0, measured.output);
+  CHECK(mlmap::test::contains(measured.output, "NOT VERIFIED"));
+  CHECK(mlmap::test::contains(measured.output, "--scan-noise"));
+  const auto given = mlmap::test::runCli(command + (dir / "given.tum").string() + " --scan-noise 0.012");
+  REQUIRE_MESSAGE(given.exit_code == 0, given.output);
+  CHECK(mlmap::test::contains(given.output, "scan 1:"));
+  CHECK_FALSE(mlmap::test::contains(given.output, "NOT VERIFIED"));
+  CHECK_FALSE(mlmap::test::contains(given.output, "--scan-noise"));
+}
