@@ -12,6 +12,7 @@
 #include "cli_runner.hpp"
 #include "helpers.hpp"
 #include "mlmap/io/pcd.hpp"
+#include "mlmap/io/tum_poses.hpp"
 #include "mlmap/registration/sequence_registration.hpp"
 
 using namespace mlmap::registration;
@@ -148,13 +149,7 @@ TEST_CASE("Real scans: register says what to do when the scans disagree by more 
   }
   mlmap::test::TempDir dir;
   const std::string poses = (dir / "start.tum").string();
-  {
-    std::ofstream out(poses);
-    const Eigen::Quaterniond q(ndtStart().linear());
-    const Eigen::Vector3d t = ndtStart().translation();
-    out << "0 0 0 0 0 0 0 1\n1 " << t.x() << ' ' << t.y() << ' ' << t.z() << ' ' << q.x() << ' ' << q.y() << ' '
-        << q.z() << ' ' << q.w() << '\n';
-  }
+  mlmap::io::writeTumPoses(poses, {{0.0, mlmap::Pose::Identity()}, {1.0, ndtStart()}});
   const std::string scans = ((*data / "pcl_room_scans" / "room_scan1.pcd").string() + " " +
                              (*data / "pcl_room_scans" / "room_scan2.pcd").string());
   const std::string command = "--quiet register --no-refine --poses " + poses + " " + scans + " -o ";
