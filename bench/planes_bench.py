@@ -86,13 +86,15 @@ def build_detect_label(mlmap, scans, poses, cell, m, ml, pj, lab, range_sigma=0.
     """The pipeline the figures come from: the block layer of the scans at their poses
     (written to m), the planes detected (the labelled map ml, the JSON pj) and every point
     labelled with its patch (lab, in scan order, as the simulator's all_world.xyz).
+    poses None: the scans are world-frame clouds without poses (--identity).
     Returns the build's wall time in s."""
+    posed = ["--poses", poses] if poses else ["--identity", "--min-range", "0"]
     t0 = time.monotonic()
-    run([mlmap, "-q", "build", "-o", m, "--poses", poses, "--cell-size", str(cell),
+    run([mlmap, "-q", "build", "-o", m, *posed, "--cell-size", str(cell),
          "--range-sigma", str(range_sigma), "--no-octree", *build_args] + scans)
     build_s = time.monotonic() - t0
     run([mlmap, "-q", "planes", m, "--json", pj, "-o", ml, *planes_args])
-    run([mlmap, "-q", "label", ml, "--poses", poses, "-o", lab, *label_args] + scans)
+    run([mlmap, "-q", "label", ml, *posed, "-o", lab, *label_args] + scans)
     return build_s
 
 

@@ -29,6 +29,9 @@ order; the points' coordinates play no part in it). Conditions:
              per beam (not in the default run)
     odom     the drifting odometry poses corrected by `mlmap register` instead of the true
              ones (not in the default run; add it with --conditions)
+    cloud    the scans merged into one world-frame cloud without poses, mapped and labelled
+             with --identity (a registered cloud as labelled rooms are shared: no scanner
+             positions, so no beams; not in the default run)
 
 Every variant is built, detected and labelled as bench/planes_bench.py does (its
 build_detect_label) and scored with ../shared/peers/score.py: patch P/R/F1 at IoU >= 0.5
@@ -76,6 +79,7 @@ CONDITIONS = {
                 "angular_step_deg": 0.2},
     "yup": {},
     "odom": {},
+    "cloud": {},
 }
 # The classes issue 19's held-out rooms label (the rest of their points unlabelled).
 LABELLED_CLASSES = ("wall", "floor", "ceiling", "table")
@@ -163,6 +167,14 @@ def write_moved_planes(src, dst, r, t):
         n = apply(r, p["normal"])
         p["normal"], p["d"] = n, p["d"] - sum(a * b for a, b in zip(n, t))
     json.dump(planes, open(dst, "w"))
+
+
+def write_moved_cloud(src, dst, r, t):
+    """The simulator's world points (x y z label) moved by (R, t), as x y z: one cloud."""
+    import numpy as np
+    xyz = np.loadtxt(src, usecols=(0, 1, 2))
+    np.savetxt(dst, xyz @ np.array(r).T + np.array(t), fmt="%.5f")
+    return dst
 
 
 def read_last_column(path):
@@ -310,7 +322,7 @@ def main():
     for scene, cell, cond, angle, seed in variants:
         if (scene, cell, cond, float(angle), seed) in done:
             continue
-        sim_cond = "base" if cond in ("yup", "odom") else cond
+        sim_cond = "base" if cond in ("yup", "odom", "cloud") else cond
         for c in dict.fromkeys(["base", sim_cond]):  # base first: the cut scales by its points
             if (scene, c) not in sims:
                 sims[(scene, c)] = simulate(mlmap, scene, c, os.path.join(a.out, "sim"), a.resimulate)
@@ -329,6 +341,9 @@ def main():
             pb.run([mlmap, "-q", "register", "--poses", poses + ".odom", "-o", poses] + scans)
         files = [os.path.join(vdir, tag + ext) for ext in (".mlmap", ".labelled.mlmap", ".planes.json", ".labels.xyz")]
         up = ["--up", "y"] if cond == "yup" else []
+        if cond == "cloud":  # one registered cloud, as labelled rooms come: no poses, no beams
+            scans, poses = [write_moved_cloud(os.path.join(sim, "all_world.xyz"), os.path.join(vdir, tag + ".xyz"),
+                                              r, t)], None
         t0 = time.monotonic()
         pb.build_detect_label(mlmap, scans, poses, cell, *files, range_sigma=sigma,
                               build_args=up if "build" in up_commands else [],
