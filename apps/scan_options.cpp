@@ -140,6 +140,11 @@ io::ScanInputCounts ScanReading::forEach(const io::ScanSequence::Visit& visit,
     const io::RangeLimits& range = sequence_.input().range;
     std::fprintf(stderr, "%s: dropped %zu readings nearer than %g m and %zu beyond %g m (--min-range, --max-range)\n",
                  command_.c_str(), counts.too_near, range.min, counts.too_far, range.max);
+    // A scanner's own and no-return readings are a few percent of a scan (3DTK's: ~5 %).
+    if (counts.too_near + counts.too_far > counts.points)
+      std::fprintf(stderr, "%s: that is most of them; the limits are distances from the scanner, and a scan without a "
+                           "pose is seen from its frame's origin: a cloud registered in another frame needs "
+                           "--min-range 0 and a --max-range beyond its extent\n", command_.c_str());
   }
   return counts;
 }

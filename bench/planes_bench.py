@@ -88,7 +88,7 @@ def build_detect_label(mlmap, scans, poses, cell, m, ml, pj, lab, range_sigma=0.
     labelled with its patch (lab, in scan order, as the simulator's all_world.xyz).
     poses None: the scans are world-frame clouds without poses (--identity).
     Returns the build's wall time in s."""
-    posed = ["--poses", poses] if poses else ["--identity", "--min-range", "0"]
+    posed = ["--poses", poses] if poses else ["--identity", "--min-range", "0", "--max-range", "1e4"]
     t0 = time.monotonic()
     run([mlmap, "-q", "build", "-o", m, *posed, "--cell-size", str(cell),
          "--range-sigma", str(range_sigma), "--no-octree", *build_args] + scans)

@@ -165,6 +165,36 @@ TEST_CASE("CLI: the range limits keep a scanner's junk readings out of the map")
   CHECK(mlmap::test::contains(counted.output, "dropped 1500 readings nearer than 0.4 m and 1500 beyond 30 m"));
 }
 
+TEST_CASE("CLI: a cloud registered far from its frame's origin is refused by the range limits, not mapped empty") {
+  mlmap::test::TempDir dir;
+  // The room as one registered cloud 40 m out along x and y: read without a pose it is
+  // "seen" from the origin, 40-50 m away, beyond the default 30 m. The map was empty
+  // and the build said only how many readings it dropped (exit 0).
+  mlmap::Scan cloud = roomScan(false);
+  for (mlmap::Point& point : cloud.points) point += Eigen::Vector3d(40.0, 40.0, 0.0);
+  const std::string scan = (dir / "far.xyz").string();
+  const std::string map = (dir / "far.mlmap").string();
+  mlmap::io::writeXyz(scan, cloud);
+  checkOneLineError(runCli("--quiet build --identity -o " + map + " " + scan),
+                    "far.xyz (scan 1): none of its 30000 readings lies within 0.4-30 m of the scanner");
+  CHECK_FALSE(fs::exists(map));
+  const auto wide = runCli("--quiet build --identity --min-range 0 --max-range 60 -o " + map + " " + scan);
+  REQUIRE_MESSAGE(wide.exit_code == 0, wide.output);
+  const auto bounds = infoOf(map)["bounds"];
+  CHECK(bounds["max"][0].get<double>() - bounds["min"][0].get<double>() == doctest::Approx(6.0).epsilon(0.05));
+  // The message names the limits that would map it.
+  const auto refused = runCli("--quiet build --identity -o " + map + ".b " + scan);
+  CHECK(mlmap::test::contains(refused.output, "--min-range 0 --max-range"));
+  // label refuses the same scan under the same limits, where every point would be "none".
+  REQUIRE(runCli("--quiet planes " + map + " -o " + map + ".l").exit_code == 0);
+  checkOneLineError(runCli("--quiet label --identity " + map + ".l -o " + (dir / "far.labels.xyz").string() + " " + scan),
+                    "far.xyz (scan 1): none of its");
+  CHECK_FALSE(fs::exists(dir / "far.labels.xyz"));
+  const auto labelled = runCli("--quiet label --identity --min-range 0 --max-range 60 " + map + ".l -o " +
+                               (dir / "far.labels.xyz").string() + " " + scan);
+  CHECK_MESSAGE(labelled.exit_code == 0, labelled.output);
+}
+
 TEST_CASE("CLI: a y-up cloud is warned about, and --up auto or --up y turns it z-up") {
   mlmap::test::TempDir dir;
   // An office of 10 × 8 m: floor and ceiling outweigh the walls, as in most rooms (a

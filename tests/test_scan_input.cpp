@@ -136,3 +136,21 @@ TEST_CASE("Scan input: pose counts, formats and missing files fail before any sc
                        }),
                        "range limits"));
 }
+
+TEST_CASE("Scan input: a scan with readings but none within the range limits is an error naming it") {
+  Scan far;
+  for (int k = 0; k < 20; ++k) far.points.emplace_back(45.0 + 0.1 * k, 40.0, 1.0);
+  const std::string message = test::errorOf([&] { io::requireReadingsInRange(far, io::RangeLimits{}, "cloud.xyz"); });
+  CHECK(test::contains(message, "cloud.xyz: none of its 20 readings lies within 0.4-30 m"));
+  CHECK(test::contains(message, "60.2-61.6 m"));
+  CHECK(test::contains(message, "--max-range 63"));
+  // One reading within them is enough (a scan of junk and one wall is the reader's to map).
+  far.points.emplace_back(3.0, 0.0, 0.0);
+  CHECK_NOTHROW(io::requireReadingsInRange(far, io::RangeLimits{}, "cloud.xyz"));
+  // Nothing finite, or nothing at all: nothing to say here.
+  Scan empty;
+  CHECK_NOTHROW(io::requireReadingsInRange(empty, io::RangeLimits{}, "empty.xyz"));
+  Scan unknown;
+  unknown.points.emplace_back(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0);
+  CHECK_NOTHROW(io::requireReadingsInRange(unknown, io::RangeLimits{}, "nan.xyz"));
+}

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <string>
 
 #include "mlmap/error.hpp"
@@ -12,6 +14,11 @@ namespace {
 
 std::string noPoseMessage(const std::filesystem::path& file) {
   return file.string() + ": the scan carries no pose; give --poses, or --identity to map it at the origin";
+}
+
+// A file's name and the scan's number in the sequence (a .graph file holds several).
+std::string scanName(const std::filesystem::path& file, std::size_t index) {
+  return file.string() + " (scan " + std::to_string(index + 1) + ")";
 }
 
 }  // namespace
@@ -32,6 +39,25 @@ std::size_t applyRangeLimits(Scan& scan, const RangeLimits& limits) {
   if (with_variances) scan.variances.resize(kept);
   if (with_labels) scan.labels.resize(kept);
   return dropped;
+}
+
+void requireReadingsInRange(const Scan& scan, const RangeLimits& limits, const std::string& where) {
+  double nearest = std::numeric_limits<double>::infinity();
+  double farthest = 0.0;
+  for (const Point& point : scan.points) {
+    if (limits.contains(point)) return;
+    const double range = point.norm();
+    if (!std::isfinite(range)) continue;
+    nearest = std::min(nearest, range);
+    farthest = std::max(farthest, range);
+  }
+  if (!(farthest >= nearest)) return;  // no finite readings: the reader's to judge
+  char text[320];
+  std::snprintf(text, sizeof text,
+                ": none of its %zu readings lies within %g-%g m of the scanner (they lie %.1f-%.1f m from it); a "
+                "cloud registered in another frame, read without a pose, needs --min-range 0 --max-range %.0f",
+                scan.size(), limits.min, limits.max, nearest, farthest, std::ceil(farthest + 1.0));
+  throw Error(where + text);
 }
 
 ScanSequence::ScanSequence(ScanInput input) : input_(std::move(input)) {
@@ -83,6 +109,7 @@ ScanInputCounts ScanSequence::forEach(const Visit& visit, const std::function<vo
         if (input_.range.contains(point)) continue;
         ++(point.squaredNorm() < min_squared ? counts.too_near : counts.too_far);
       }
+      requireReadingsInRange(scan, input_.range, scanName(input_.files[file], index));
       applyRangeLimits(scan, input_.range);
       scan.pose = input_.world * scan.pose;
       counts.points += scan.size();
