@@ -30,8 +30,8 @@ order; the points' coordinates play no part in it). Conditions:
     odom     the drifting odometry poses corrected by `mlmap register` instead of the true
              ones (not in the default run; add it with --conditions)
     cloud    the scans merged into one world-frame cloud without poses, mapped and labelled
-             with --identity (a registered cloud as labelled rooms are shared: no scanner
-             positions, so no beams; not in the default run)
+             with --identity and no range limits (a registered cloud as labelled rooms are
+             shared: no scanner positions, so no beams; not in the default run)
 
 Every variant is built, detected and labelled as bench/planes_bench.py does (its
 build_detect_label) and scored with ../shared/peers/score.py: patch P/R/F1 at IoU >= 0.5
