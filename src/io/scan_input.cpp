@@ -54,8 +54,8 @@ void requireReadingsInRange(const Scan& scan, const RangeLimits& limits, const s
   if (!(farthest >= nearest)) return;  // no finite readings: the reader's to judge
   char text[320];
   std::snprintf(text, sizeof text,
-                ": none of its %zu readings lies within %g-%g m of the scanner (they lie %.1f-%.1f m from it); a "
-                "cloud registered in another frame, read without a pose, needs --min-range 0 --max-range %.0f",
+                ": none of its %zu readings lies within %g-%g m of the scanner (they lie %.4g-%.4g m from it); a "
+                "cloud registered in another frame, read without a pose, needs --min-range 0 --max-range %.4g",
                 scan.size(), limits.min, limits.max, nearest, farthest, std::ceil(farthest + 1.0));
   throw Error(where + text);
 }
