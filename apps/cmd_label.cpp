@@ -44,8 +44,7 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
   reading.forEach(
       [&](Scan& scan, std::size_t index, std::size_t file) {
         // The build refused such a scan: with other limits here every point would be "none".
-        io::requireReadingsInRange(scan, arguments.input.range,
-                                   arguments.input.scans[file] + " (scan " + std::to_string(index + 1) + ")");
+        io::requireReadingsInRange(scan, arguments.input.range, arguments.input.scans[file], index);
         const std::vector<std::int32_t> labels = labelPoints(map.blocks(), scan);
         const auto scan_index = static_cast<std::uint32_t>(scanner_positions.size());
         scanner_positions.push_back(scan.pose.translation());

@@ -140,23 +140,23 @@ TEST_CASE("Scan input: pose counts, formats and missing files fail before any sc
 TEST_CASE("Scan input: a scan with readings but none within the range limits is an error naming it") {
   Scan far;
   for (int k = 0; k < 20; ++k) far.points.emplace_back(45.0 + 0.1 * k, 40.0, 1.0);
-  const std::string message = test::errorOf([&] { io::requireReadingsInRange(far, io::RangeLimits{}, "cloud.xyz"); });
-  CHECK(test::contains(message, "cloud.xyz: none of its 20 readings lies within 0.4-30 m"));
+  const std::string message = test::errorOf([&] { io::requireReadingsInRange(far, io::RangeLimits{}, "cloud.xyz", 0); });
+  CHECK(test::contains(message, "cloud.xyz (scan 1): none of its 20 readings lies within 0.4-30 m"));
   CHECK(test::contains(message, "60.22-61.65 m"));
   CHECK(test::contains(message, "--max-range 63"));
   // One reading within them is enough (a scan of junk and one wall is the reader's to map).
   far.points.emplace_back(3.0, 0.0, 0.0);
-  CHECK_NOTHROW(io::requireReadingsInRange(far, io::RangeLimits{}, "cloud.xyz"));
+  CHECK_NOTHROW(io::requireReadingsInRange(far, io::RangeLimits{}, "cloud.xyz", 0));
   // Hostile values: four digits, not a hundred.
   Scan huge;
   huge.points.emplace_back(1e100, 0.0, 0.0);
-  const std::string huge_message = test::errorOf([&] { io::requireReadingsInRange(huge, io::RangeLimits{}, "huge.xyz"); });
+  const std::string huge_message = test::errorOf([&] { io::requireReadingsInRange(huge, io::RangeLimits{}, "huge.xyz", 0); });
   CHECK(test::contains(huge_message, "they lie 1e+100-1e+100 m"));
   CHECK(huge_message.size() < 250);
   // Nothing finite, or nothing at all: nothing to say here.
   Scan empty;
-  CHECK_NOTHROW(io::requireReadingsInRange(empty, io::RangeLimits{}, "empty.xyz"));
+  CHECK_NOTHROW(io::requireReadingsInRange(empty, io::RangeLimits{}, "empty.xyz", 0));
   Scan unknown;
   unknown.points.emplace_back(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0);
-  CHECK_NOTHROW(io::requireReadingsInRange(unknown, io::RangeLimits{}, "nan.xyz"));
+  CHECK_NOTHROW(io::requireReadingsInRange(unknown, io::RangeLimits{}, "nan.xyz", 0));
 }

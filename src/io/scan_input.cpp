@@ -16,11 +16,6 @@ std::string noPoseMessage(const std::filesystem::path& file) {
   return file.string() + ": the scan carries no pose; give --poses, or --identity to map it at the origin";
 }
 
-// A file's name and the scan's number in the sequence (a .graph file holds several).
-std::string scanName(const std::filesystem::path& file, std::size_t index) {
-  return file.string() + " (scan " + std::to_string(index + 1) + ")";
-}
-
 }  // namespace
 
 std::size_t applyRangeLimits(Scan& scan, const RangeLimits& limits) {
@@ -41,7 +36,8 @@ std::size_t applyRangeLimits(Scan& scan, const RangeLimits& limits) {
   return dropped;
 }
 
-void requireReadingsInRange(const Scan& scan, const RangeLimits& limits, const std::string& where) {
+void requireReadingsInRange(const Scan& scan, const RangeLimits& limits, const std::filesystem::path& file,
+                            std::size_t index) {
   double nearest = std::numeric_limits<double>::infinity();
   double farthest = 0.0;
   for (const Point& point : scan.points) {
@@ -57,7 +53,7 @@ void requireReadingsInRange(const Scan& scan, const RangeLimits& limits, const s
                 ": none of its %zu readings lies within %g-%g m of the scanner (they lie %.4g-%.4g m from it); a "
                 "cloud registered in another frame, read without a pose, needs --min-range 0 --max-range %.4g",
                 scan.size(), limits.min, limits.max, nearest, farthest, std::ceil(farthest + 1.0));
-  throw Error(where + text);
+  throw Error(file.string() + " (scan " + std::to_string(index + 1) + ")" + text);
 }
 
 ScanSequence::ScanSequence(ScanInput input) : input_(std::move(input)) {
@@ -109,7 +105,7 @@ ScanInputCounts ScanSequence::forEach(const Visit& visit, const std::function<vo
         if (input_.range.contains(point)) continue;
         ++(point.squaredNorm() < min_squared ? counts.too_near : counts.too_far);
       }
-      requireReadingsInRange(scan, input_.range, scanName(input_.files[file], index));
+      requireReadingsInRange(scan, input_.range, input_.files[file], index);
       applyRangeLimits(scan, input_.range);
       scan.pose = input_.world * scan.pose;
       counts.points += scan.size();

@@ -7,7 +7,6 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
-#include <string>
 #include <vector>
 
 #include "mlmap/io/tum_poses.hpp"
@@ -39,11 +38,13 @@ struct RangeLimits {
 // Returns how many it dropped.
 std::size_t applyRangeLimits(Scan& scan, const RangeLimits& limits);
 
-// Throws an Error naming `where` when the scan holds readings but none within the limits:
+// Throws an Error naming the file and the scan's number in the sequence (`index`, from 0;
+// a .graph file holds several) when the scan holds readings but none within the limits:
 // a cloud registered in another frame and read without a pose (--identity) is "seen"
 // from that frame's origin, which may lie tens of metres away or inside the room, and
 // the map of it would be empty.
-void requireReadingsInRange(const Scan& scan, const RangeLimits& limits, const std::string& where);
+void requireReadingsInRange(const Scan& scan, const RangeLimits& limits, const std::filesystem::path& file,
+                            std::size_t index);
 
 struct ScanInput {
   std::vector<std::filesystem::path> files{};  // in order; a .graph holds several scans
