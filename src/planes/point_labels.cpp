@@ -248,9 +248,8 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     if (found > 1 && std::any_of(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within))
       found = static_cast<std::size_t>(std::partition(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within) -
                                        candidates.begin());
-    const std::uint32_t chosen =
-        likeliest(std::span(candidates.data(), found), fitted, origin, beam,
-                  [&](const Candidate& c) { return onPatch(points[index], beam, c); });
+    const std::uint32_t chosen = likeliest(std::span(candidates.data(), found), fitted, beam,
+                                           [&](const Candidate& c) { return onPatch(points[index], beam, c); });
     labels[index] = chosen != 0 ? fitted[chosen].id : labels[index] < 0 ? -1 : 0;
   }
   fitted.erase(fitted.begin());  // slot 0, "none"
