@@ -131,13 +131,26 @@ struct LabelAgreement {
   std::size_t misplaced() const { return labelled - on_majority; }
 };
 
-inline LabelAgreement labelAgreement(const std::vector<std::int32_t>& predicted, const std::vector<std::int32_t>& truth) {
+// Patch -> true plane -> points, over the points with a patch (label > 0).
+using TruthByPatch = std::map<std::int32_t, std::map<std::int32_t, std::size_t>>;
+
+inline TruthByPatch truthByPatch(const std::vector<std::int32_t>& predicted, const std::vector<std::int32_t>& truth) {
   REQUIRE(predicted.size() == truth.size());
-  std::map<std::int32_t, std::map<std::int32_t, std::size_t>> counts;  // patch -> true plane -> points
+  TruthByPatch counts;
   for (std::size_t k = 0; k < predicted.size(); ++k)
     if (predicted[k] > 0) ++counts[predicted[k]][truth[k]];
+  return counts;
+}
+
+// The true plane most of one patch's points lie on.
+inline std::int32_t majorityTruth(const std::map<std::int32_t, std::size_t>& by_truth) {
+  return std::max_element(by_truth.begin(), by_truth.end(),
+                          [](const auto& a, const auto& b) { return a.second < b.second; })->first;
+}
+
+inline LabelAgreement labelAgreement(const std::vector<std::int32_t>& predicted, const std::vector<std::int32_t>& truth) {
   LabelAgreement agreement;
-  for (const auto& [patch, by_truth] : counts) {
+  for (const auto& [patch, by_truth] : truthByPatch(predicted, truth)) {
     std::size_t best = 0;
     for (const auto& [plane, count] : by_truth) {
       best = std::max(best, count);

@@ -90,6 +90,24 @@ struct Scanned {
   }
 };
 
+// A 6 x 5 x 2.8 m room (its floor, ceiling and walls are true planes 0-5) with the given
+// poses and furniture, scanned with 1 cm of range noise at 0.5 deg beams and 1 deg lines.
+std::string boxRoomScene(const std::string& poses, const std::string& furniture) {
+  return R"({
+    "scan_pattern": {"angular_step_deg": 0.5, "tilt_start_deg": -50, "tilt_end_deg": 50,
+                     "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
+    "poses": [)" + poses + R"(],
+    "surfaces": [
+      {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [6, 5, 0]},
+      {"type": "rectangle", "class": "ceiling", "min": [0, 0, 2.8], "max": [6, 5, 2.8]},
+      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 5, 2.8]},
+      {"type": "rectangle", "class": "wall", "min": [6, 0, 0], "max": [6, 5, 2.8]},
+      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [6, 0, 2.8]},
+      {"type": "rectangle", "class": "wall", "min": [0, 5, 0], "max": [6, 5, 2.8]},
+      )" + furniture + R"(
+    ]})";
+}
+
 }  // namespace
 
 TEST_CASE("Point labels: floor points in the wall's corner blocks leave the wall for the floor") {
@@ -254,34 +272,19 @@ TEST_CASE("Point labels: at the foot of a cabinet and above its side, the floor'
   // of range noise. Points where they meet the floor or the wall lie within noise of both
   // planes and go to the larger patch; a plane is only where its patch is (above the
   // cabinet its side's plane is air).
-  const char* const scene_json = R"({
-    "scan_pattern": {"angular_step_deg": 0.5, "tilt_start_deg": -50, "tilt_end_deg": 50,
-                     "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
-    "poses": [{"x": 2.5, "y": 2.0, "yaw_deg": 150}, {"x": 3.5, "y": 3.2, "yaw_deg": 200},
-              {"x": 2.0, "y": 3.5, "yaw_deg": -90}],
-    "surfaces": [
-      {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [6, 5, 0]},
-      {"type": "rectangle", "class": "ceiling", "min": [0, 0, 2.8], "max": [6, 5, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 5, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [6, 0, 0], "max": [6, 5, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [6, 0, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [0, 5, 0], "max": [6, 5, 2.8]},
-      {"type": "box", "class": "other", "min": [0, 1.0, 0], "max": [0.5, 3.0, 1.8], "omit": ["bottom", "x-"]},
-      {"type": "box", "class": "other", "min": [4.0, 1.0, 0], "max": [4.6, 1.5, 0.5], "omit": ["bottom"]}
-    ]})";
-  const Scanned scanned(scene_json, "cabinet.json");
+  const Scanned scanned(
+      boxRoomScene(R"({"x": 2.5, "y": 2.0, "yaw_deg": 150}, {"x": 3.5, "y": 3.2, "yaw_deg": 200},
+                      {"x": 2.0, "y": 3.5, "yaw_deg": -90})",
+                   R"({"type": "box", "class": "other", "min": [0, 1.0, 0], "max": [0.5, 3.0, 1.8], "omit": ["bottom", "x-"]},
+      {"type": "box", "class": "other", "min": [4.0, 1.0, 0], "max": [4.6, 1.5, 0.5], "omit": ["bottom"]})"),
+      "cabinet.json");
   const std::vector<Point>& points = scanned.points;
   const std::vector<std::int32_t>& truth = scanned.truth;
   std::vector<std::int32_t> labels = scanned.blockLabels();
   refinePointLabels(scanned.map, scanned.detection.planes, points, labels, scanned.options(), scanned.beams());
   // Each patch's surface: the true plane most of its points lie on.
-  std::map<std::int32_t, std::map<std::int32_t, std::size_t>> counts;
-  for (std::size_t k = 0; k < points.size(); ++k)
-    if (labels[k] > 0) ++counts[labels[k]][truth[k]];
   std::map<std::int32_t, std::int32_t> surface_of;
-  for (const auto& [patch, by_truth] : counts)
-    surface_of[patch] = std::max_element(by_truth.begin(), by_truth.end(),
-                                          [](const auto& a, const auto& b) { return a.second < b.second; })->first;
+  for (const auto& [patch, by_truth] : test::truthByPatch(labels, truth)) surface_of[patch] = test::majorityTruth(by_truth);
   // The room's own surfaces are planes 0-5; their points on a patch of the furniture's.
   std::size_t room = 0, taken = 0, swapped = 0;
   for (std::size_t k = 0; k < points.size(); ++k) {
@@ -305,37 +308,22 @@ TEST_CASE("Point labels: a crate's patches end at the floor and the wall they st
   // within noise of both planes; it goes to the larger patch, the floor's or the wall's, so
   // that no crate's patch holds a point of them (a patch precision at point IoU counts every
   // such patch against the detection, however few of the floor's points it holds).
-  const char* const scene_json = R"({
-    "scan_pattern": {"angular_step_deg": 0.5, "tilt_start_deg": -50, "tilt_end_deg": 50,
-                     "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
-    "poses": [{"x": 3.0, "y": 2.5, "yaw_deg": 20}, {"x": 4.5, "y": 1.5, "yaw_deg": 160},
-              {"x": 1.5, "y": 3.5, "yaw_deg": -60}],
-    "surfaces": [
-      {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [6, 5, 0]},
-      {"type": "rectangle", "class": "ceiling", "min": [0, 0, 2.8], "max": [6, 5, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 5, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [6, 0, 0], "max": [6, 5, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [6, 0, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [0, 5, 0], "max": [6, 5, 2.8]},
-      {"type": "box", "class": "other", "min": [1.0, 1.0, 0], "max": [1.6, 1.5, 0.5], "omit": ["bottom"]},
+  const Scanned scanned(
+      boxRoomScene(R"({"x": 3.0, "y": 2.5, "yaw_deg": 20}, {"x": 4.5, "y": 1.5, "yaw_deg": 160},
+                      {"x": 1.5, "y": 3.5, "yaw_deg": -60})",
+                   R"({"type": "box", "class": "other", "min": [1.0, 1.0, 0], "max": [1.6, 1.5, 0.5], "omit": ["bottom"]},
       {"type": "box", "class": "other", "min": [4.2, 3.4, 0], "max": [4.9, 4.0, 0.6], "omit": ["bottom"]},
       {"type": "box", "class": "other", "min": [2.4, 4.4, 0], "max": [3.2, 5.0, 0.7], "omit": ["bottom", "y+"]},
-      {"type": "box", "class": "other", "min": [5.3, 0.8, 0], "max": [6.0, 1.6, 0.9], "omit": ["bottom", "x+"]}
-    ]})";
-  const Scanned scanned(scene_json, "crates.json");
+      {"type": "box", "class": "other", "min": [5.3, 0.8, 0], "max": [6.0, 1.6, 0.9], "omit": ["bottom", "x+"]})"),
+      "crates.json");
   for (const bool with_beams : {true, false}) {
     CAPTURE(with_beams);
     std::vector<std::int32_t> labels = scanned.blockLabels();
     refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, scanned.options(),
                       with_beams ? scanned.beams() : BeamOrigins{});
-    std::map<std::int32_t, std::map<std::int32_t, std::size_t>> counts;
-    for (std::size_t k = 0; k < scanned.points.size(); ++k)
-      if (labels[k] > 0) ++counts[labels[k]][scanned.truth[k]];
     std::size_t crate_patches = 0, touching = 0, room_points_taken = 0;
-    for (const auto& [patch, by_truth] : counts) {
-      const auto most = std::max_element(by_truth.begin(), by_truth.end(),
-                                         [](const auto& a, const auto& b) { return a.second < b.second; });
-      if (most->first <= 5) continue;  // the room's surfaces are planes 0-5
+    for (const auto& [patch, by_truth] : test::truthByPatch(labels, scanned.truth)) {
+      if (test::majorityTruth(by_truth) <= 5) continue;  // the room's surfaces are planes 0-5
       ++crate_patches;
       std::size_t room = 0;
       for (const auto& [surface, n] : by_truth) room += surface >= 0 && surface <= 5 ? n : 0;
