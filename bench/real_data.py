@@ -33,8 +33,9 @@ y-up scans (office1) are passed with `--up y` when `mlmap build --help` lists it
 z-up scans (the benchmark turns them itself). Scans go to mlmap as .xyz files in their sensor
 frame with a TUM pose file where the sensor position is known (so that `label` knows the
 beams' origins), as world points otherwise. Missing data, annotations or peers are skipped
-with a message. Writes out/real/NAME/*, out/real/real_data.md and, with --docs, one small
-picture per scene (docs/real-NAME.png).
+with a message. Writes out/real/NAME/*, out/real/real_data.md, out/real/real_data.json (the
+totals per method and each marked surface's found / not found, for bench/real_seeds.py) and,
+with --docs, one small picture per scene (docs/real-NAME.png).
 """
 import argparse, json, math, os, re, subprocess, sys, time
 
@@ -229,12 +230,20 @@ def issue_counts(annotation, rows):
     within 0.5 cm (RMS) of the largest patch's plane as of their own least-squares fit."""
     counts = dict(structural_found=0, structural=0, other_found=0, other=0, rms_ok=0)
     for surface, row in zip(annotation["surfaces"], rows):
-        structural = surface["kind"] in ("floor", "ceiling", "wall")
-        key = "structural" if structural else "other"
+        key = "structural" if is_structural(surface) else "other"
         counts[key] += 1
-        counts[key + "_found"] += int(row["share"] >= (0.9 if structural else 0.7) and row["joined"] == 0)
+        counts[key + "_found"] += int(is_found(surface, row))
         counts["rms_ok"] += int(row["n10"] > 0 and not math.isnan(row["rms"]) and row["rms"] - row["own"] <= 0.005)
     return counts
+
+
+def is_structural(surface):
+    return surface["kind"] in ("floor", "ceiling", "wall")
+
+
+def is_found(surface, row):
+    """>= 90 % (walls, floor, ceiling) or >= 70 % (the others) of the surface on one patch that joins no other."""
+    return row["share"] >= (0.9 if is_structural(surface) else 0.7) and row["joined"] == 0
 
 
 def found_count(annotation, rows):
@@ -373,7 +382,7 @@ def main():
         print(f"real_data: no cgal_ransac in {a.peers}, CGAL skipped")
     features = {c: options_of(mlmap, c) for c in ("build", "label", "register")}
     cells = [float(c) for c in a.cells.split(",")]
-    report, totals = [], {}
+    report, totals, verdicts = [], {}, []
     for name, scene, why in real_clouds.scenes(a.data):
         if a.only and name not in a.only.split(","):
             continue
@@ -413,6 +422,8 @@ def main():
             for key, count in issue_counts(annotation, result["rows"]).items():
                 total[key] += count
             total["stray"] += result["extra"]["stray_patches"]
+            verdicts += [dict(scene=name, surface=surface["name"], method=method, found=bool(is_found(surface, row)))
+                         for surface, row in zip(annotation["surfaces"], result["rows"])]
             total["detect_s"] += result["times"]["detect_s"]
         scorer = os.path.join(os.path.dirname(a.data), "peers", "score.py")
         if os.path.exists(scorer):
@@ -437,6 +448,7 @@ def main():
                 f"{time.strftime('%Y-%m-%d %H:%M')}, load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores\n")
         print(head)
         open(os.path.join(a.out, "real_data.md"), "w").write(head + "\n" + "\n".join(report))
+        json.dump(dict(totals=totals, surfaces=verdicts), open(os.path.join(a.out, "real_data.json"), "w"), indent=1)
 
 
 if __name__ == "__main__":

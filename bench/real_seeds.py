@@ -13,44 +13,20 @@ seed (and per build, with --against), and this prints, per build and cell size, 
 totals and their sum, and with --against which marked surfaces pass in one build and not in
 the other, seed by seed. Skipped with a message where ../shared/data is absent.
 """
-import argparse, os, re, subprocess, sys
+import argparse, json, os, subprocess, sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 
-# real_data.md's totals, as totals_table writes them.
-TOTALS = (("found", r"\| surfaces found \| (.*) \|"),
-          ("walls/floor/ceiling", r"\| walls, floor, ceiling: >= 90 % on a patch joining no other \| (.*) \|"),
-          ("others", r"\| the others \(tables, treads, steps\): >= 70 % \| (.*) \|"),
-          ("rms", r"\| RMS to the patch's plane within 0.5 cm of the points' own fit \| (.*) \|"),
-          ("stray patches", r"\| patches on no marked surface \| (.*) \|"))
-STRUCTURAL = ("wall", "floor", "ceiling")
+# real_data.json's totals per method, as real_data.py counts them: (column, found key, of key).
+TOTALS = (("found", "found", "marked"), ("walls/floor/ceiling", "structural_found", "structural"),
+          ("others", "other_found", "other"), ("rms", "rms_ok", "marked"), ("stray patches", "stray", None))
+CELLS = ("mlmap 0.05", "mlmap 0.1")
 
 
-def totals(report):
-    """{figure: [value per mlmap column]} from a real_data.md (the counts before "of")."""
-    text = open(report).read().split("#### all scans")[-1]
-    out = {}
-    for name, pattern in TOTALS:
-        match = re.search(pattern, text)
-        out[name] = [int(cell.split(" of ")[0]) for cell in match.group(1).split(" | ")] if match else []
-    return out
-
-
-def passing(report):
-    """{(scene, surface, cell): True} for the marked surfaces found, from the per-scene tables."""
-    found, scene = set(), None
-    for line in open(report):
-        if line.startswith("#### "):
-            scene = line[5:].split(":")[0]
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if not line.startswith("| ") or len(cells) < 11 or cells[1] not in STRUCTURAL + ("table", "tread", "step"):
-            continue
-        need = 90 if cells[1] in STRUCTURAL else 70
-        for cell, (share, joins) in (("0.05", (3, 5)), ("0.1", (7, 9))):
-            if cells[share].isdigit() and int(cells[share]) >= need and cells[joins] == "0":
-                found.add((scene, cells[0], cell))
-    return found
+def passing(result):
+    """{(scene, surface, method)} of the marked surfaces real_data.py found."""
+    return {(v["scene"], v["surface"], v["method"]) for v in result["surfaces"] if v["found"]}
 
 
 def main():
@@ -73,28 +49,39 @@ def main():
             out = os.path.join(a.out, f"{tag}-seed{seed}")
             cmd = [sys.executable, os.path.join(HERE, "real_data.py"), "--build", build, "--out", out,
                    "--data", a.data, f"--planes-args=--seed {seed}"] + (["--only", a.only] if a.only else [])
+            stale = os.path.join(out, "real_data.json")
+            if os.path.exists(stale):
+                os.remove(stale)  # a result is this run's or none
             print(f"real_seeds: {build}, seed {seed}", file=sys.stderr, flush=True)
             done = subprocess.run(cmd, capture_output=True, text=True)
             if done.returncode != 0:
                 raise SystemExit(f"real_seeds: real_data.py failed for {build}, seed {seed}:\n{done.stderr[-2000:]}")
-            reports[(tag, seed)] = os.path.join(out, "real_data.md")
-    print("| build | seed | " + " | ".join(f"{name} 0.05 / 0.1" for name, _ in TOTALS) + " |")
+            reports[(tag, seed)] = os.path.join(out, "real_data.json")
+            if not os.path.exists(reports[(tag, seed)]):
+                raise SystemExit(f"real_seeds: real_data.py scored no scene for {build}, seed {seed}:\n{done.stdout[-2000:]}")
+    results = {key: json.load(open(path)) for key, path in reports.items()}
+    print("| build | seed | " + " | ".join(f"{name} 0.05 / 0.1" for name, _, _ in TOTALS) + " |")
     print("|---|---|" + "---|" * len(TOTALS))
     for tag, build in builds:
-        sums = {name: [0, 0] for name, _ in TOTALS}
+        sums = {name: [0, 0] for name, _, _ in TOTALS}
         for seed in seeds:
-            figures = totals(reports[(tag, seed)])
-            for name, _ in TOTALS:
-                for k, value in enumerate(figures[name][:2]):
-                    sums[name][k] += value
-            print(f"| {build} | {seed} | " + " | ".join(" / ".join(map(str, figures[name][:2])) for name, _ in TOTALS) + " |")
-        print(f"| {build} | sum | " + " | ".join(" / ".join(map(str, sums[name])) for name, _ in TOTALS) + " |")
+            totals = results[(tag, seed)]["totals"]
+            row = []
+            for name, key, _ in TOTALS:
+                values = [totals[cell][key] if cell in totals else 0 for cell in CELLS]
+                sums[name] = [total + value for total, value in zip(sums[name], values)]
+                row.append(" / ".join(map(str, values)))
+            print(f"| {build} | {seed} | " + " | ".join(row) + " |")
+        first = results[(tag, seeds[0])]["totals"]
+        of = [" of " + " / ".join(str(len(seeds) * first[cell][of_key]) for cell in CELLS if cell in first)
+              if of_key else "" for _, _, of_key in TOTALS]
+        print(f"| {build} | sum | " + " | ".join(" / ".join(map(str, sums[name])) + tail
+                                              for (name, _, _), tail in zip(TOTALS, of)) + " |")
     if a.against:
         print()
         for seed in seeds:
-            first, second = passing(reports[("build", seed)]), passing(reports[("against", seed)])
+            first, second = passing(results[("build", seed)]), passing(results[("against", seed)])
             print(f"seed {seed}: found only with {a.build}: {sorted(first - second)}; only with {a.against}: {sorted(second - first)}")
-
 
 if __name__ == "__main__":
     main()
