@@ -24,6 +24,7 @@ int runCalibrate(const CalibrateOptions& options) {
   checkWritable(options.output);
   std::vector<Scan> scans = io::readScans(options.scan);
   if (scans.empty()) throw Error(options.scan + ": no scan");
+  io::requireReadingsInRange(scans.front(), options.range, options.scan, 0);
   io::applyRangeLimits(scans.front(), options.range);
   const registration::FloorCalibration calibration =
       registration::calibrateFromFloor(scans.front().points, options.config);

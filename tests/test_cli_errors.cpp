@@ -193,6 +193,10 @@ TEST_CASE("CLI: a cloud registered far from its frame's origin is refused by the
   const auto labelled = runCli("--quiet label --identity --min-range 0 --max-range 60 " + map + ".l -o " +
                                (dir / "far.labels.xyz").string() + " " + scan);
   CHECK_MESSAGE(labelled.exit_code == 0, labelled.output);
+  // calibrate too (it said "0 points lie below the sensor", as if no floor had been scanned).
+  checkOneLineError(runCli("--quiet calibrate " + scan + " -o " + (dir / "mount.json").string()),
+                    "far.xyz (scan 1): none of its 30000 readings lies within 0.4-30 m of the scanner");
+  CHECK_FALSE(fs::exists(dir / "mount.json"));
 }
 
 TEST_CASE("CLI: a y-up cloud is warned about, and --up auto or --up y turns it z-up") {

@@ -101,11 +101,13 @@ ScanInputCounts ScanSequence::forEach(const Visit& visit, const std::function<vo
         }
         scan.pose = poses_[index].pose;
       }
+      std::size_t outside = 0;
       for (const Point& point : scan.points) {
         if (input_.range.contains(point)) continue;
+        ++outside;
         ++(point.squaredNorm() < min_squared ? counts.too_near : counts.too_far);
       }
-      requireReadingsInRange(scan, input_.range, input_.files[file], index);
+      if (outside == scan.size()) requireReadingsInRange(scan, input_.range, input_.files[file], index);
       applyRangeLimits(scan, input_.range);
       scan.pose = input_.world * scan.pose;
       counts.points += scan.size();
