@@ -35,10 +35,24 @@ def _in_region(points, region):
     if "box" in region:
         lo, hi = np.array(region["box"][0]), np.array(region["box"][1])
         return np.all((points >= lo) & (points <= hi), axis=1)
-    from matplotlib.path import Path
     z0, z1 = region["z"]
-    inside = Path(np.array(region["polygon"])).contains_points(points[:, :2])
-    return inside & (points[:, 2] >= z0) & (points[:, 2] <= z1)
+    return _in_polygon(points[:, :2], np.array(region["polygon"], dtype=float)) & \
+        (points[:, 2] >= z0) & (points[:, 2] <= z1)
+
+
+def _in_polygon(xy, polygon):
+    """Even-odd rule: a point is inside when a ray towards +x crosses the outline an odd number of
+    times (numpy only, so scoring needs no plotting library)."""
+    inside = np.zeros(len(xy), dtype=bool)
+    x, y = xy[:, 0], xy[:, 1]
+    for (xa, ya), (xb, yb) in zip(polygon, np.roll(polygon, -1, axis=0)):
+        straddles = (ya > y) != (yb > y)
+        if not straddles.any():
+            continue
+        with np.errstate(divide="ignore", invalid="ignore"):
+            crossing_x = xa + (y - ya) * (xb - xa) / (yb - ya)
+        inside ^= straddles & (x < crossing_x)
+    return inside
 
 
 def surface_mask(points, surface):

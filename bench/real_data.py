@@ -374,6 +374,11 @@ def main():
     if not os.path.isdir(a.data):
         print(f"real_data: skipped, no data directory at {a.data}")
         return
+    if a.docs:
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            raise SystemExit("real_data: --docs draws with matplotlib: apt-get install python3-matplotlib")
     mlmap = os.path.join(a.build, "mlmap")
     if not os.access(mlmap, os.X_OK):
         raise SystemExit(f"real_data: no mlmap CLI at {mlmap} (build it first, or give --build)")
