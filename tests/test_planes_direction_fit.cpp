@@ -77,3 +77,27 @@ TEST_CASE("Direction fit: planes whose blocks agree with them, and level planes,
   const CandidatePlane floor = planeThrough(Eigen::Vector3f(0.035F, 0.0F, 1.0F), Eigen::Vector3f(3.0F, -1.5F, 0.0F));
   CHECK_FALSE(alongDirections(grid, directions, scorer, scorer.matching(floor), floor, kPlumbTilt).has_value());
 }
+
+// A wall that truly leans (PCL's room scans: 2.3° by their points' own fit) keeps its lean:
+// vertical blocks' directions lie in the level plane and say nothing about it. Turned plumb
+// in 3-D, the wall's top lay 10 cm off the turned plane at 2.4 m, beyond ε.
+TEST_CASE("Direction fit: a leaning wall's own plane is not turned plumb") {
+  for (const unsigned seed : {1U, 2U, 3U}) {
+    CAPTURE(seed);
+    const double lean = 2.3 * std::numbers::pi / 180.0;
+    test::PlaneSceneBuilder scene(0.05, 0.01, seed);
+    scene.withNoise(0.01, 1e-4)
+        .floor(-1.0, -3.0, 6.0, 0.5, 0.0)
+        .rectangle(Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(5.0, 0.0, 0.0),
+                   Eigen::Vector3d(0.0, 2.4 * std::sin(lean), 2.4 * std::cos(lean)));
+    const BlockGrid grid(scene.map());
+    const std::vector<Eigen::Vector3f> directions = directionField(grid, DirectionConfig{}).vectors;
+    const PlaneScorer scorer(grid, directions, kEpsilon, kKappa);
+    const Eigen::Vector3f normal(0.0F, static_cast<float>(std::cos(lean)), static_cast<float>(-std::sin(lean)));
+    const CandidatePlane wall = planeThrough(normal, Eigen::Vector3f(2.5F, static_cast<float>(1.2 * std::sin(lean)), 1.2F));
+    const std::vector<std::uint32_t> strict = scorer.matching(wall);
+    REQUIRE(strict.size() > 30);
+    const std::optional<CandidatePlane> turned = alongDirections(grid, directions, scorer, strict, wall, kPlumbTilt);
+    if (turned) CHECK(angleDeg(turned->normal, normal) < 0.3);
+  }
+}

@@ -22,10 +22,11 @@
 namespace mlmap {
 
 // For a plumb plane (its normal within `max_tilt_rad` of horizontal: walls; level planes'
-// blocks turn with what lies on them) whose matching blocks `strict` have a mean direction
-// further from its normal than kTurnStandardErrors standard errors of that mean and kMinTurn:
-// the plane along that direction through the layer of those blocks that holds the most
-// surface (the ε-wide window of their offsets along it). None otherwise.
+// blocks turn with what lies on them) whose matching blocks `strict` have a mean heading (their
+// directions' azimuth) further from its normal's than kTurnStandardErrors standard errors of
+// that mean and kMinTurn: the plane turned to that heading, keeping its own lean, through the
+// layer of those blocks that holds the most surface (the ε-wide window of their offsets along
+// it). None otherwise.
 std::optional<CandidatePlane> alongDirections(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                               const PlaneScorer& scorer, const std::vector<std::uint32_t>& strict,
                                               const CandidatePlane& plane, double max_tilt_rad);
