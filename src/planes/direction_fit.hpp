@@ -22,11 +22,13 @@
 namespace mlmap {
 
 // For a plumb plane (its normal within `max_tilt_rad` of horizontal: walls; level planes'
-// blocks turn with what lies on them) whose matching blocks `strict` have a mean heading (their
-// directions' azimuth) further from its normal's than kTurnStandardErrors standard errors of
-// that mean and kMinTurn: the plane turned to that heading, keeping its own lean, through the
+// blocks turn with what lies on them) whose matching blocks `strict` disagree with it: (a) where
+// their mean heading (the directions' azimuth) lies further from the normal's than
+// kTurnStandardErrors standard errors of that mean and kMinTurn, the plane turned to that
+// heading at its own lean; (b) where their mean 3-D direction (plumb, for walls' blocks) does,
+// the plane turned onto it if that holds more untaken surface than the plane. Each through the
 // layer of those blocks that holds the most surface (the ε-wide window of their offsets along
-// it). None otherwise.
+// it); of (a) and (b) the one holding more surface. None otherwise.
 std::optional<CandidatePlane> alongDirections(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                               const PlaneScorer& scorer, const std::vector<std::uint32_t>& strict,
                                               const CandidatePlane& plane, double max_tilt_rad);
