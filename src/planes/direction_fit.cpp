@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <vector>
 #include <utility>
+#include <vector>
 
 namespace mlmap {
 namespace {
@@ -59,7 +59,8 @@ std::optional<Eigen::Matrix<double, N, 1>> significantMean(const BlockGrid& grid
   double weight = 0.0, weight_sq = 0.0, sine_sq = 0.0;
   for (const std::uint32_t id : strict) {
     Eigen::Matrix<double, N, 1> d = directions[id].head<N>().template cast<double>();
-    // In the level plane, level blocks' directions (a wall's top, a sill) point up: no heading.
+    // Blocks without a direction, and in the level plane those whose direction points up
+    // (a wall's top, a sill): no heading.
     if (!(d.squaredNorm() > 0.5)) continue;
     d.normalize();
     if (d.dot(axis) < 0.0) d = -d;
@@ -95,20 +96,15 @@ std::optional<CandidatePlane> alongDirections(const BlockGrid& grid, const std::
   // 1.5-2.3° by their points' own fit; a generated wall leaning 2.3° was turned 2.1-2.3°,
   // its top 10 cm off the turned plane at 2.4 m). Where both apply, the one that holds more.
   std::optional<CandidatePlane> best;
-  double best_score = 0.0;
   if (const auto heading = significantMean<2>(grid, directions, strict, Eigen::Vector2d(normal.head<2>().normalized()))) {
     const double level_part = std::sqrt(std::max(0.0, 1.0 - normal.z() * normal.z()));
     const Eigen::Vector3d kept(level_part * heading->x(), level_part * heading->y(), normal.z());
     best = throughDensestLayer(grid, scorer, strict, plane, kept);
-    best_score = scorer.score(*best).score;
   }
   if (const auto mean = significantMean<3>(grid, directions, strict, normal)) {
     const CandidatePlane turned = throughDensestLayer(grid, scorer, strict, plane, *mean);
-    const double score = scorer.score(turned).score;
-    if (score > std::max(best_score, scorer.score(plane).score)) {
-      best = turned;
-      best_score = score;
-    }
+    const double rival = std::max(best ? scorer.score(*best).score : 0.0, scorer.score(plane).score);
+    if (scorer.score(turned).score > rival) best = turned;
   }
   return best;
 }

@@ -83,12 +83,9 @@ PointMoments patchMoments(const BlockGrid& grid, const std::vector<std::uint32_t
   return points;
 }
 
-PointMoments sum(const PointMoments& first, const PointMoments& second) {
-  PointMoments both = first;
-  both.count += second.count;
-  both.sum += second.sum;
-  both.outer += second.outer;
-  return both;
+PointMoments sum(PointMoments first, const PointMoments& second) {
+  first.merge(second);
+  return first;
 }
 
 // The RMS distance of points from their least-squares plane; nullopt for fewer than 3.

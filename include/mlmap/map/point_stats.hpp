@@ -50,6 +50,12 @@ struct PointMoments {
   // Adds a block's points; `centre` is the block's point-stats frame (its cell centre
   // at z 0) relative to the origin.
   void add(const PointStats& stats, const Eigen::Vector3d& centre);
+  // Adds moments taken about the same origin (another patch's): their union's.
+  void merge(const PointMoments& other) {
+    count += other.count;
+    sum += other.sum;
+    outer += other.outer;
+  }
   Eigen::Vector3d mean() const { return sum / count; }
   Eigen::Matrix3d covariance() const {
     const Eigen::Vector3d m = mean();
