@@ -223,7 +223,8 @@ def main():
             mine = points[owner == k]
             plane = np.array(surface["plane"])
             settled = settled_plane(points, surface)
-            angle = np.degrees(np.arccos(min(1.0, abs(float(settled[:3] @ plane[:3])))))
+            # Marked normals are rounded to 4 decimals: not quite unit (0.9999 reads as 0.8 deg).
+            angle = np.degrees(np.arccos(min(1.0, abs(float(settled[:3] @ plane[:3]) / np.linalg.norm(plane[:3])))))
             warn = "  <- not its own settled plane" if angle > 0.5 else ""
             print(f"{surface['name']:>16} {surface['kind']:>8} {len(mine):7d} pts, rms to plane {rms_to_plane(mine, plane[:3], plane[3]):.4f}, "
                   f"settled plane {angle:.2f} deg off{warn}")

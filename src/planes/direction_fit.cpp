@@ -92,9 +92,10 @@ std::optional<CandidatePlane> alongDirections(const BlockGrid& grid, const std::
   // blocks' mean direction in 3-D (plumb for walls' blocks), where those differ, and only
   // where that holds more surface than the plane: a plane leaning between two layers
   // stacked one over the other is turned plumb, a wall that truly leans keeps its lean
-  // (turned plumb, its top is left beyond ε: three of PCL's room_scan2's four walls lean
-  // 1.5-2.3° by their points' own fit; a generated wall leaning 2.3° was turned 2.1-2.3°,
-  // its top 10 cm off the turned plane at 2.4 m). Where both apply, the one that holds more.
+  // (turned plumb, its top is left beyond ε: PCL's room_scan2, whose scanner stood 1.7°
+  // off level, has a wall leaning 2.3° by its points' own fit; a generated wall leaning
+  // 2.3° was turned 2.1-2.3°, its top 10 cm off the turned plane at 2.4 m). Where both
+  // apply, the one that holds more.
   std::optional<CandidatePlane> best;
   if (const auto heading = significantMean<2>(grid, directions, strict, Eigen::Vector2d(normal.head<2>().normalized()))) {
     const double level_part = std::sqrt(std::max(0.0, 1.0 - normal.z() * normal.z()));
