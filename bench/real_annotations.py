@@ -111,7 +111,7 @@ def settled_plane(points, surface, rounds=30):
     """The plane a surface's marking settles on: fitted (plain least squares) to the points of its
     region within its tolerance, then to those within the tolerance of that fit, until they stay the
     same. A marked plane that is not its own settled plane was fitted with points of something
-    else (room_scan1/2's wall y3.09 with a cabinet front 13 cm proud of it, 1.3-2.7 deg off the wall)."""
+    else (room_scan1/2's wall y3.09 with a door recess 13 cm behind it, 1.3-2.7 deg off the wall)."""
     inside = _in_region(points, surface["region"])
     for hole in surface.get("exclude", []):
         inside &= ~_in_region(points, hole)
