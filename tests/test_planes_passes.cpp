@@ -45,6 +45,7 @@ void checkSameAsOnePass(MLMap& map, const PlaneDetection& measured) {
   ErmsmConfig given;
   given.noise = measured.config.noise;
   given.epsilon = measured.config.epsilon;
+  given.ladder_blocks = measured.config.ladder_blocks;
   const PlaneDetection once = detectPlanes(map, given);
   CHECK(once.stats.passes == 1);
   checkSamePlanes(measured, once);
@@ -80,9 +81,13 @@ TEST_CASE("Planes, second pass: σ moved, what depends on it is made again") {
 
 TEST_CASE("Planes, second pass: where the short first search labels too few blocks, the whole one measures σ") {
   // 2.5 cm of scatter where 3 mm were assumed: the first 100 idle candidates find too
-  // little to measure σ on, the whole search of 300 does.
+  // little to measure σ on, the whole search of 300 does. Ladders of six: with four, the
+  // walls' columns, split by the scatter into short blocks, are wall blocks again and the
+  // short search finds enough.
   test::PlaneSceneBuilder scene = room(0.025, 0.003, 2);
-  const PlaneDetection measured = detectPlanes(scene.map());
+  ErmsmConfig config;
+  config.ladder_blocks = 6;
+  const PlaneDetection measured = detectPlanes(scene.map(), config);
   CAPTURE(measured.config.noise);
   REQUIRE(measured.stats.passes == 3);
   CHECK(measured.stats.prior_noise > 0.0);

@@ -35,7 +35,12 @@ struct ErmsmConfig {
   // apart, is one eRMSM block too (a surface seen at a grazing angle or far away,
   // its scan lines further apart than the stack gap); 0 = no ladders.
   double ladder_gap = 0.2;
-  int ladder_blocks = 6;
+  // Four: two or three short blocks that far apart are as likely a shelf or a seat over a
+  // step (BlockGridConfig). Six, as before, left walls seen as four or five scan lines as
+  // rungs (Bobkov's room 2 above its sideboard, fr079's walls and the PCL room scans' far
+  // walls at 10 cm cells, ANYmal's treads at 10 cm: bench/real_seeds.py, seeds 1-3, found
+  // 111 / 103 -> 114 / 116 of 192 at 5 / 10 cm; three rungs 113 / 114).
+  int ladder_blocks = 4;
   double kappa_deg = 25.0;        // deg, max angle between a block's direction and the plane, κ
   double theta_deg = 15.0;        // deg, max angle between the three seeds' directions, θ
   double min_probability = 0.99;  // p_t of eq. 10's acceptance test
