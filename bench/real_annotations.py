@@ -205,6 +205,10 @@ def main():
     points = _scene(a.name, a.data).world()
     box = np.array([float(v) for v in a.box.split(",")]) if a.box else None
     if a.tool == "views":
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            raise SystemExit("real_annotations: views draws with matplotlib: apt-get install python3-matplotlib")
         out = os.path.join(a.out, f"{a.name}_views{'_' + a.box.replace(',', '_') if a.box else ''}.png")
         views(points, out, a.name, box)
         print(out, len(points), "points; extent", points.min(axis=0).round(2), points.max(axis=0).round(2))
@@ -228,9 +232,15 @@ def main():
             warn = "  <- not its own settled plane" if angle > 0.5 else ""
             print(f"{surface['name']:>16} {surface['kind']:>8} {len(mine):7d} pts, rms to plane {rms_to_plane(mine, plane[:3], plane[3]):.4f}, "
                   f"settled plane {angle:.2f} deg off{warn}")
+        print(f"{(owner >= 0).mean():.2f} of points on a surface")
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            print("real_annotations: no picture (it draws with matplotlib: apt-get install python3-matplotlib)")
+            return
         out = os.path.join(a.out, f"{a.name}_check.png")
         check_picture(points, annotation, out, a.name, dpi=90)
-        print(out, f"{(owner >= 0).mean():.2f} of points on a surface")
+        print(out)
 
 
 if __name__ == "__main__":
