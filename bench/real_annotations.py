@@ -60,13 +60,18 @@ def _in_polygon(xy, polygon):
     return inside
 
 
-def surface_mask(points, surface):
-    """Points of one annotated surface: in its region, out of its exclusions, near its plane."""
+def _in_marked_region(points, surface):
+    """Points in a surface's region and out of its exclusions (whatever their distance from its plane)."""
     mask = _in_region(points, surface["region"])
     for hole in surface.get("exclude", []):
         mask &= ~_in_region(points, hole)
+    return mask
+
+
+def surface_mask(points, surface):
+    """Points of one annotated surface: in its region, out of its exclusions, near its plane."""
     plane = np.array(surface["plane"])
-    return mask & (np.abs(points @ plane[:3] + plane[3]) <= surface["tolerance"])
+    return _in_marked_region(points, surface) & (np.abs(points @ plane[:3] + plane[3]) <= surface["tolerance"])
 
 
 def load(name):
@@ -112,9 +117,7 @@ def settled_plane(points, surface, rounds=30):
     region within its tolerance, then to those within the tolerance of that fit, until they stay the
     same. A marked plane that is not its own settled plane was fitted with points of something
     else (room_scan1/2's wall y3.09 with a door recess 13 cm behind it, 1.3-2.7 deg off the wall)."""
-    inside = _in_region(points, surface["region"])
-    for hole in surface.get("exclude", []):
-        inside &= ~_in_region(points, hole)
+    inside = _in_marked_region(points, surface)
     plane = np.array(surface["plane"], dtype=float)
     for _ in range(rounds):
         near = points[inside & (np.abs(points @ plane[:3] + plane[3]) <= surface["tolerance"])]
@@ -135,6 +138,15 @@ def rms_to_plane(points, normal, d):
 
 
 # ------------------------------------------------------------------ the tools used by hand
+
+def _has_matplotlib():
+    """The pictures draw with matplotlib, which neither install script installs."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
 
 def _scene(name, data):
     sys.path.insert(0, HERE)
@@ -205,9 +217,7 @@ def main():
     points = _scene(a.name, a.data).world()
     box = np.array([float(v) for v in a.box.split(",")]) if a.box else None
     if a.tool == "views":
-        try:
-            import matplotlib  # noqa: F401
-        except ImportError:
+        if not _has_matplotlib():
             raise SystemExit("real_annotations: views draws with matplotlib: apt-get install python3-matplotlib")
         out = os.path.join(a.out, f"{a.name}_views{'_' + a.box.replace(',', '_') if a.box else ''}.png")
         views(points, out, a.name, box)
@@ -233,9 +243,7 @@ def main():
             print(f"{surface['name']:>16} {surface['kind']:>8} {len(mine):7d} pts, rms to plane {rms_to_plane(mine, plane[:3], plane[3]):.4f}, "
                   f"settled plane {angle:.2f} deg off{warn}")
         print(f"{(owner >= 0).mean():.2f} of points on a surface")
-        try:
-            import matplotlib  # noqa: F401
-        except ImportError:
+        if not _has_matplotlib():
             print("real_annotations: no picture (it draws with matplotlib: apt-get install python3-matplotlib)")
             return
         out = os.path.join(a.out, f"{a.name}_check.png")
