@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "bevels.hpp"
+#include "creases.hpp"
 #include "detector.hpp"
 #include "median.hpp"
 #include "mlmap/planes/block_grid.hpp"
@@ -194,6 +195,10 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   PatchSet patches = detector.run(stats);
   stage();
   dropBevels(grid, patches, config.epsilon, radians(config.kappa_deg));
+  // Once σ is known: compromises across shallow creases into their faces (creases.hpp).
+  if (sheets && hasPointStats(map))
+    splitCreases(grid, patches, {config.noise, config.epsilon, radians(config.kappa_deg), config.min_patch_blocks,
+                                 config.min_patch_area});
   // The map's surface, each block's bottom weighted by its points: whether anything lies
   // under the lowest level patch.
   std::vector<SurfaceSample> bottoms;

@@ -1,0 +1,64 @@
+// Faces that meet at shallow creases (issue 19: plane_seg's tilted-steps scan, a field of
+// cinder blocks whose tops are tilted 13° in turn, each 0.4 m across). Each face lies
+// within ε's floor (5 cm at 5 cm cells) of one level plane through all of them, and the
+// blocks' direction windows (five cells across) straddle the creases of faces eight cells
+// wide, so the search took the four faces as one patch 2-3° off level with twice their
+// points' RMS. Each face is its own patch now, on its own plane.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "mlmap/planes/ermsm.hpp"
+#include "plane_scenes.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+struct Face {
+  Eigen::Vector3d corner;  // its low corner
+  Eigen::Vector3d u;       // along one side
+  Eigen::Vector3d v;       // along the other
+  Eigen::Vector3d normal() const { return u.cross(v).normalized(); }
+  Eigen::Vector3d centre() const { return corner + 0.5 * (u + v); }
+};
+
+}  // namespace
+
+TEST_CASE("eRMSM: cinder-block tops tilted 13 degrees in turn are four patches, not one level compromise") {
+  const double side = 0.42;
+  const double rise = side * std::tan(13.0 * std::numbers::pi / 180.0);  // 9.7 cm over a face
+  const double x0 = 1.0 + 0.05 / 3.0;
+  const double y0 = 1.0 + 0.05 / 3.0;
+  const double z0 = 0.10;
+  // Rising towards +x, towards -x, level, rising towards +y: the tilted-steps field's A, C1, C2, B.
+  const Face faces[] = {
+      {{x0, y0 + side, z0}, {side, 0.0, rise}, {0.0, side, 0.0}},
+      {{x0, y0, z0 + rise}, {side, 0.0, -rise}, {0.0, side, 0.0}},
+      {{x0 + side, y0, z0 + 0.02}, {side, 0.0, 0.0}, {0.0, side, 0.0}},
+      {{x0 + side, y0 + side, z0}, {side, 0.0, 0.0}, {0.0, side, rise}},
+  };
+  for (const unsigned seed : {1U, 2U}) {
+    CAPTURE(seed);
+    test::PlaneSceneBuilder scene(0.05, 0.005, seed);
+    scene.withNoise(0.005, 2.5e-5).floor(0.0, 0.0, 3.0, 3.0, 0.0);
+    for (const Face& face : faces) scene.rectangle(face.corner, face.u, face.v);
+    const PlaneDetection detection = detectPlanes(scene.map());
+    for (const Face& face : faces) {
+      CAPTURE(face.normal().transpose());
+      // The patch centred nearest the face's centre, within a quarter of a face.
+      const Plane* found = nullptr;
+      for (const Plane& plane : detection.planes) {
+        const double apart = (plane.centroid - face.centre()).norm();
+        if (apart < 0.25 * side && (found == nullptr || apart < (found->centroid - face.centre()).norm())) found = &plane;
+      }
+      REQUIRE(found != nullptr);
+      const double angle = std::acos(std::min(1.0, std::abs(found->normal.dot(face.normal())))) * 180.0 / std::numbers::pi;
+      CHECK(angle < 3.0);
+      CHECK(found->rms < 0.01);
+      CHECK(found->area > 0.5 * side * side);
+      CHECK(found->area < 1.5 * side * side);
+    }
+  }
+}
