@@ -25,11 +25,13 @@ struct CreaseConfig {
 // windows over neighbours whose windows turn less than κ / 3; faces too small (under
 // the patch minimum in blocks, half the minimum area: a face's rim windows straddle its
 // creases), not spread both ways, or flatter than σ / 3 (one scan line's sweep plane)
-// are dropped; every block goes to the face its points lie nearest; faces that then
-// touch and turn less than κ / 3 are one (a warped or layered surface). The split
-// stands when two touching faces turn more than κ / 3 (a crease) and the faces' squared
-// residuals are at most a quarter of the patch's (their RMS half). Connected pieces of a
-// face too small for half the minimum area go back to no patch. The first face keeps the
+// are dropped; every block goes to the face its points lie nearest, or to none where they
+// lie more than 3 σ (RMS) off every face; faces that then touch and turn less than κ / 3
+// are one (a warped or layered surface). The split stands when two touching faces turn
+// more than κ / 3 (a crease), the faces' squared residuals are at most a quarter of the
+// patch's over the same blocks (their RMS half), and at most 15 % of the patch's points lie
+// on no face. Blocks on no face, and connected pieces of a face too small for half the
+// minimum area, go back to no patch. The first face keeps the
 // patch's id, the others are appended; their outlines are left pending.
 void splitCreases(const BlockGrid& grid, PatchSet& set, const CreaseConfig& config);
 
