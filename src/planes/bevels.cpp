@@ -105,23 +105,7 @@ void dropBevels(const BlockGrid& grid, PatchSet& set, double epsilon, double kap
       }
     }
   }
-  if (std::none_of(drop.begin(), drop.end(), [](bool d) { return d; })) return;
-  std::vector<std::int32_t> new_id(count, 0);
-  PatchSet kept;
-  kept.labels = std::move(set.labels);
-  for (std::size_t k = 0; k < count; ++k) {
-    if (drop[k]) continue;
-    Plane plane = std::move(set.planes[k]);
-    plane.id = static_cast<std::int32_t>(kept.planes.size() + 1);
-    new_id[k] = plane.id;
-    kept.planes.push_back(std::move(plane));
-    kept.blocks.push_back(std::move(set.blocks[k]));
-    kept.outline_frames.push_back(set.outline_frames[k]);
-    kept.outline_runs.push_back(std::move(set.outline_runs[k]));
-  }
-  for (std::int32_t& label : kept.labels)
-    if (label > 0) label = new_id[static_cast<std::size_t>(label - 1)];
-  set = std::move(kept);
+  dropPatches(set, drop);
 }
 
 }  // namespace mlmap

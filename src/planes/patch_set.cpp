@@ -196,6 +196,27 @@ Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePl
   return plane;
 }
 
+void dropPatches(PatchSet& set, const std::vector<bool>& drop) {
+  if (std::none_of(drop.begin(), drop.end(), [](bool d) { return d; })) return;
+  const std::size_t count = set.planes.size();
+  std::vector<std::int32_t> new_id(count, 0);
+  PatchSet kept;
+  kept.labels = std::move(set.labels);
+  for (std::size_t k = 0; k < count; ++k) {
+    if (drop[k]) continue;
+    Plane plane = std::move(set.planes[k]);
+    plane.id = static_cast<std::int32_t>(kept.planes.size() + 1);
+    new_id[k] = plane.id;
+    kept.planes.push_back(std::move(plane));
+    kept.blocks.push_back(std::move(set.blocks[k]));
+    kept.outline_frames.push_back(set.outline_frames[k]);
+    kept.outline_runs.push_back(std::move(set.outline_runs[k]));
+  }
+  for (std::int32_t& label : kept.labels)
+    if (label > 0) label = new_id[static_cast<std::size_t>(label - 1)];
+  set = std::move(kept);
+}
+
 void tracePendingOutlines(const BlockGrid& grid, PatchSet& set, int threads) {
   std::vector<std::size_t> pending;
   for (std::size_t k = 0; k < set.planes.size(); ++k) {

@@ -41,6 +41,10 @@ struct PatchSet {
 Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad,
                     double noise);
 
+// Removes the patches flagged in `drop` (one flag per plane): their blocks go back to no
+// patch, the others are renumbered 1..n in order and the block labels follow.
+void dropPatches(PatchSet& set, const std::vector<bool>& drop);
+
 // Traces the pending outlines (each plane on its own, on `threads` threads, 0 =
 // OpenMP's default) and moves them onto their planes as describePatch would have.
 void tracePendingOutlines(const BlockGrid& grid, PatchSet& set, int threads);
