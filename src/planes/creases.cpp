@@ -274,14 +274,15 @@ std::vector<std::vector<std::size_t>> facesOf(const BlockGrid& grid, const Patch
 
 }  // namespace
 
-void splitCreases(const BlockGrid& grid, PatchSet& set, const CreaseConfig& config) {
-  if (config.noise <= 0.0) return;
+std::vector<int> splitCreases(const BlockGrid& grid, PatchSet& set, const CreaseConfig& config) {
+  std::vector<int> split;  // per plane: the patch it was split from, -1 for none
+  if (config.noise <= 0.0) return split;
   const std::size_t count = set.planes.size();
   for (std::size_t k = 0; k < count; ++k) {
     const Plane& plane = set.planes[k];
     if (!(plane.rms > kRoughSigmas * config.noise) || set.blocks[k].size() < 2 * static_cast<std::size_t>(config.min_blocks))
       continue;
-    if (grid.pointsOf(set.blocks[k].front()).empty()) return;  // a map without point moments
+    if (grid.pointsOf(set.blocks[k].front()).empty()) return split;  // a map without point moments
     const std::vector<std::vector<std::size_t>> faces = facesOf(grid, set, k, config);
     if (faces.empty()) continue;
     const std::vector<std::uint32_t> blocks = set.blocks[k];
@@ -335,8 +336,14 @@ void splitCreases(const BlockGrid& grid, PatchSet& set, const CreaseConfig& conf
       set.planes[k] = original;
       set.blocks[k] = blocks;
       for (const std::uint32_t id : blocks) set.labels[id] = original.id;
+    } else {
+      split.resize(set.planes.size(), -1);
+      split[k] = static_cast<int>(k);
+      for (std::size_t f = split.size(); f-- > 0 && f >= count;)
+        if (split[f] < 0) split[f] = static_cast<int>(k);
     }
   }
+  return split;
 }
 
 }  // namespace mlmap

@@ -8,6 +8,8 @@
 // turns with its face.
 #pragma once
 
+#include <vector>
+
 #include "patch_set.hpp"
 
 namespace mlmap {
@@ -32,7 +34,8 @@ struct CreaseConfig {
 // patch's over the same blocks (their RMS half), and at most 15 % of the patch's points lie
 // on no face. Blocks on no face, and connected pieces of a face too small for half the
 // minimum area, go back to no patch. The first face keeps the
-// patch's id, the others are appended; their outlines are left pending.
-void splitCreases(const BlockGrid& grid, PatchSet& set, const CreaseConfig& config);
+// patch's id, the others are appended; their outlines are left pending. Returns, per
+// plane, the index of the patch it was split from (-1 for none); empty where none was.
+std::vector<int> splitCreases(const BlockGrid& grid, PatchSet& set, const CreaseConfig& config);
 
 }  // namespace mlmap

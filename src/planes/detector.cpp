@@ -23,15 +23,6 @@ namespace {
 // A patch of fewer blocks has its labels written on one thread.
 constexpr std::int64_t kParallelPatchBlocks = 20000;
 
-// m: the most two neighbouring blocks of one sheet (sheets.hpp) may differ by in their
-// distance from their plane: 3 standard deviations of the difference of two points'
-// noise, 3 √2 σ, and at least a cell: a block is the mean of what its cell holds, and
-// where that is a surface's edge or a second surface (a wall's foot, a corner) the mean
-// moves by up to half a cell, two neighbours' in opposite directions. Measured on the
-// simulated lab (4 mm noise): with 3 √2 σ alone it lost 0.09 don't-care F1 at 10 cm
-// cells; with a cell, 5 and 10 cm are as without sheets, 2 cm still loses 0.02-0.05
-// (open). fr079's faces (8-10 cm apart) part at 5 cm cells, not at 10 cm.
-double sheetStep(double noise, double cell_size) { return std::max(3.0 * std::numbers::sqrt2 * noise, cell_size); }
 
 }  // namespace
 

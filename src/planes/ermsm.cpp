@@ -17,6 +17,7 @@
 #include "mlmap/planes/direction_vectors.hpp"
 #include "patch_merges.hpp"
 #include "patch_set.hpp"
+#include "sheets.hpp"
 #include "surface_noise.hpp"
 
 namespace mlmap {
@@ -196,9 +197,17 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   stage();
   dropBevels(grid, patches, config.epsilon, radians(config.kappa_deg));
   // Once σ is known: compromises across shallow creases into their faces (creases.hpp).
-  if (sheets && hasPointStats(map))
-    splitCreases(grid, patches, {config.noise, config.epsilon, radians(config.kappa_deg), config.min_patch_blocks,
-                                 config.min_patch_area});
+  // A face of a split patch may lie on another patch's plane (3DTK's ceiling fixture: its
+  // level face on the ceiling's): the coplanar merge again, for patches parallel within
+  // κ / 3, and never two faces of one split.
+  if (sheets && hasPointStats(map)) {
+    const std::vector<int> faces_of = splitCreases(
+        grid, patches,
+        {config.noise, config.epsilon, radians(config.kappa_deg), config.min_patch_blocks, config.min_patch_area});
+    if (!faces_of.empty())
+      mergeCoplanar(grid, patches, std::min(config.epsilon + 0.5 * grid.cellSize(), sheetStep(config.noise, grid.cellSize())),
+                    2.0 * radians(config.kappa_deg) / 3.0, config.noise, faces_of);
+  }
   // The map's surface, each block's bottom weighted by its points: whether anything lies
   // under the lowest level patch.
   std::vector<SurfaceSample> bottoms;

@@ -140,11 +140,16 @@ bool withinCells(const BlockGrid& grid, const std::vector<std::uint32_t>& first,
 
 }  // namespace
 
-void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad, double noise) {
+void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad, double noise,
+                   const std::vector<int>& families) {
   const std::vector<Plane>& planes = set.planes;
   const std::size_t count = planes.size();
   std::vector<std::size_t> group(count);
   for (std::size_t k = 0; k < count; ++k) group[k] = k;
+  // Per group (at its root): the families of its members.
+  std::vector<std::vector<int>> kept_apart(count);
+  for (std::size_t k = 0; k < families.size() && k < count; ++k)
+    if (families[k] >= 0) kept_apart[k].push_back(families[k]);
   auto root = [&](std::size_t k) {
     while (group[k] != k) k = group[k] = group[group[k]];
     return k;
@@ -252,6 +257,14 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
       // Bobkov's table (registered views, 2.3 and 3.3 cm, σ 1.9 cm). σ is the map's median;
       // where the pieces' own RMS is larger it speaks for their surface (the simulated lab at
       // 10 cm cells: walls 1 cm, σ read 0.4 cm).
+      // Faces a patch was split into stay apart, also through a group either joined.
+      if (touching && !families.empty()) {
+        const std::vector<int>& mine = kept_apart[root(a)];
+        const std::vector<int>& theirs = kept_apart[root(b)];
+        touching = root(a) == root(b) || std::none_of(theirs.begin(), theirs.end(), [&](int v) {
+                     return std::find(mine.begin(), mine.end(), v) != mine.end();
+                   });
+      }
       if (touching && noise > 0.0) {
         const auto oneSurface = [&](const PointMoments& one, const PointMoments& other, double own) {
           const std::optional<double> joint = planeRms(sum(one, other));
@@ -273,7 +286,14 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
           if (touching) group_moments[root_a] = sum(group_a, group_b);
         }
       }
-      if (touching) group[root(b)] = root(a);
+      if (touching) {
+        const std::size_t root_a = root(a), root_b = root(b);
+        if (root_a != root_b) {
+          std::vector<int>& mine = kept_apart[root_a];
+          mine.insert(mine.end(), kept_apart[root_b].begin(), kept_apart[root_b].end());
+          group[root_b] = root_a;
+        }
+      }
     }
   }
   std::vector<std::size_t> roots(count);

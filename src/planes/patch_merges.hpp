@@ -11,8 +11,11 @@ namespace mlmap {
 // larger's noise tail: within 3.5 of the larger's RMS, half as spread), parallel within κ / 2
 // and touch on the grid; level ones meet at one height where they meet cell to cell, and
 // (`noise` > 0) their points lie about one plane within a sheet's step. A merged group's
-// outline is left pending; `noise` σ, m, as describePatch's.
-void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad, double noise);
+// outline is left pending; `noise` σ, m, as describePatch's. Patches of one family (the
+// same non-negative value in `families`, one per plane; empty: none) never join, not
+// through others either: the faces one patch was split into (creases.hpp).
+void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double kappa_rad, double noise,
+                   const std::vector<int>& families = {});
 
 // After classification: floor and ceiling patches are one level each, however far
 // apart (a floor seen between furniture, a ceiling either side of a beam). A merged
