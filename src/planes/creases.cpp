@@ -3,8 +3,10 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <unordered_map>
+#include <vector>
 
 #include "mlmap/map/point_stats.hpp"
 
@@ -63,214 +65,267 @@ double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::acos(std::clamp(std::abs(a.dot(b)), 0.0, 1.0));
 }
 
-// The faces of one patch (indices into its blocks), or none when one plane explains it.
-std::vector<std::vector<std::size_t>> facesOf(const BlockGrid& grid, const PatchSet& set, std::size_t k,
-                                              const CreaseConfig& config) {
-  const std::vector<std::uint32_t>& blocks = set.blocks[k];
-  const Plane& plane = set.planes[k];
-  const std::size_t count = blocks.size();
-  const auto label = static_cast<std::int32_t>(k + 1);
-  const double cell = grid.cellSize();
-  const Eigen::Vector3d origin = plane.centroid;
-  std::vector<PointStats> stats(count);
-  std::vector<Eigen::Vector3d> centres(count);
-  std::unordered_map<std::uint32_t, std::size_t> index;
-  index.reserve(count);
-  for (std::size_t b = 0; b < count; ++b) {
-    stats[b] = grid.pointsOf(blocks[b]);
-    centres[b] = (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[blocks[b]].cell), 0.0).finished() - origin;
-    index.emplace(blocks[b], b);
-  }
-  const auto forNeighbours = [&](std::size_t b, auto&& visit) {
-    grid.forEachNeighbour(grid.blocks()[blocks[b]].cell, 1, [&](std::uint32_t other) {
-      if (set.labels[other] == label) visit(index.at(other));
-    });
-  };
-  // Each block's window: its points and its patch neighbours' within one cell.
-  std::vector<Window> windows(count);
-  for (std::size_t b = 0; b < count; ++b) {
-    PointMoments points;
-    forNeighbours(b, [&](std::size_t o) { points.add(stats[o], centres[o]); });
-    if (points.count < kWindowPoints) continue;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-    solver.computeDirect(points.covariance());
-    if (solver.eigenvalues()(1) < std::pow(kWindowSpreadCells * cell, 2)) continue;
-    Eigen::Vector3d normal = solver.eigenvectors().col(0);
-    if (normal.dot(plane.normal) < 0.0) normal = -normal;
-    windows[b] = {normal, std::sqrt(std::max(0.0, solver.eigenvalues()(0))), true};
-  }
-  // Faces grown from the flattest windows over neighbours whose windows turn less than
-  // κ / 3 (8.3°) from the face's mean: between the cinder faces' 13° and what one surface's
-  // windows turn by where it is warped or layered (room_scan2's wall x-2.55: pieces 0.5-5°
-  // apart; office1's far wall: layers 1.8° apart).
-  const double grow = config.kappa_rad / 3.0;
-  std::vector<std::size_t> order;
-  for (std::size_t b = 0; b < count; ++b)
-    if (windows[b].valid) order.push_back(b);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return windows[a].rms < windows[b].rms; });
-  std::vector<int> face_of(count, -1);
-  std::vector<Face> faces;
-  for (const std::size_t seed : order) {
-    if (face_of[seed] >= 0) continue;
-    Face face;
-    Eigen::Vector3d sum = windows[seed].normal;
-    const int id = static_cast<int>(faces.size());
-    face_of[seed] = id;
-    std::vector<std::size_t> queue{seed};
-    for (std::size_t q = 0; q < queue.size(); ++q) {
-      face.members.push_back(queue[q]);
-      const Eigen::Vector3d mean = sum.normalized();
-      forNeighbours(queue[q], [&](std::size_t o) {
-        if (face_of[o] >= 0 || !windows[o].valid || angleBetween(windows[o].normal, mean) > grow) return;
-        face_of[o] = id;
-        sum += windows[o].normal;
-        queue.push_back(o);
-      });
+// One patch's blocks (indexed 0..n-1 here), their points' moments about the patch's
+// centroid, and the steps that find its faces.
+class PatchFaces {
+ public:
+  PatchFaces(const BlockGrid& grid, const PatchSet& set, std::size_t k, const CreaseConfig& config)
+      : grid_(grid), set_(set), blocks_(set.blocks[k]), plane_(set.planes[k]), label_(static_cast<std::int32_t>(k + 1)),
+        config_(config), grow_(config.kappa_rad / 3.0), cell_area_(grid.cellSize() * grid.cellSize()),
+        stats_(blocks_.size()), centres_(blocks_.size()) {
+    const Eigen::Vector3d origin = plane_.centroid;
+    index_.reserve(blocks_.size());
+    for (std::size_t b = 0; b < blocks_.size(); ++b) {
+      stats_[b] = grid.pointsOf(blocks_[b]);
+      centres_[b] = (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[blocks_[b]].cell), 0.0).finished() - origin;
+      index_.emplace(blocks_[b], b);
     }
-    faces.push_back(std::move(face));
+    patch_point_ = -(plane_.normal.dot(origin) + plane_.offset) * plane_.normal;
   }
-  // Faces large enough for a patch, fitted to their own blocks' points.
-  const double cell_area = cell * cell;
-  std::vector<Face> large;
-  for (Face& face : faces) {
+
+  // The faces (indices into the patch's blocks), or none when one plane explains it.
+  std::vector<std::vector<std::size_t>> find() {
+    std::vector<Face> faces = largeFaces(grownFaces(windows()));
+    mergeTouchingOrCoplanar(faces);
+    std::vector<std::vector<std::size_t>> members;
+    std::vector<double> squared;
+    assign(faces, members, squared);
+    if (faces.size() < 2 || !creased(faces, members) || !explained(members, squared)) return {};
+    return members;
+  }
+
+ private:
+  template <typename Visit>
+  void forNeighbours(std::size_t b, Visit&& visit) const {
+    grid_.forEachNeighbour(grid_.blocks()[blocks_[b]].cell, 1, [&](std::uint32_t other) {
+      if (set_.labels[other] == label_) visit(index_.at(other));
+    });
+  }
+
+  double surfaceOf(const std::vector<std::size_t>& members) const {
     double surface = 0.0;
-    for (const std::size_t b : face.members) surface += grid.blocks()[blocks[b]].surface;
-    if (face.members.size() < static_cast<std::size_t>(config.min_blocks) || surface * cell_area < kFaceShare * config.min_area)
-      continue;
-    for (const std::size_t b : face.members) face.points.add(stats[b], centres[b]);
-    // Its points spread across the face both ways (a row of blocks along one scan line
-    // fits any plane through the line).
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-    solver.computeDirect(face.points.covariance());
-    if (solver.eigenvalues()(1) < std::pow(kFaceSpreadCells * cell, 2)) continue;
-    // ... and off its plane by about the noise: points of one or two scan lines lie in the
-    // scanner's sweep plane whatever the surface (room_scan2's wall x-2.55 at 5 cm: 12
-    // points, RMS 0, 61° off the wall).
-    if (solver.eigenvalues()(0) < std::pow(config.noise / 3.0, 2)) continue;
-    fitFace(face);
-    large.push_back(std::move(face));
+    for (const std::size_t b : members) surface += grid_.blocks()[blocks_[b]].surface;
+    return surface;
   }
-  // Faces whose planes turn less than a window may are one: touching (a surface that
-  // bends or warps, a scanner's distortion, rather than creases) or on one plane (a face
-  // cut in two by a crease's windows).
-  std::vector<int> large_of(count, -1);
-  for (std::size_t f = 0; f < large.size(); ++f)
-    for (const std::size_t b : large[f].members) large_of[b] = static_cast<int>(f);
+
   // Whether a block of `members` has a neighbour that `face_of` gives to face `other`.
-  const auto touches = [&](const std::vector<std::size_t>& members, const std::vector<int>& face_of, std::size_t other) {
+  bool touches(const std::vector<std::size_t>& members, const std::vector<int>& face_of, std::size_t other) const {
     for (const std::size_t m : members) {
       bool found = false;
       forNeighbours(m, [&](std::size_t o) { found = found || face_of[o] == static_cast<int>(other); });
       if (found) return true;
     }
     return false;
-  };
-  const auto touching = [&](std::size_t a, std::size_t b) { return touches(large[a].members, large_of, b); };
-  for (std::size_t a = 0; a < large.size(); ++a) {
-    for (std::size_t b = a + 1; b < large.size();) {
-      const bool coplanar = std::abs(large[a].normal.dot(large[b].point - large[a].point)) <= config.epsilon &&
-                            std::abs(large[b].normal.dot(large[a].point - large[b].point)) <= config.epsilon;
-      if (angleBetween(large[a].normal, large[b].normal) > grow || !(coplanar || touching(a, b))) {
-        ++b;
+  }
+
+  // Each block's window: its points and its patch neighbours' within one cell.
+  std::vector<Window> windows() const {
+    std::vector<Window> windows(blocks_.size());
+    for (std::size_t b = 0; b < blocks_.size(); ++b) {
+      PointMoments points;
+      forNeighbours(b, [&](std::size_t o) { points.add(stats_[o], centres_[o]); });
+      if (points.count < kWindowPoints) continue;
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+      solver.computeDirect(points.covariance());
+      if (solver.eigenvalues()(1) < std::pow(kWindowSpreadCells * grid_.cellSize(), 2)) continue;
+      Eigen::Vector3d normal = solver.eigenvectors().col(0);
+      if (normal.dot(plane_.normal) < 0.0) normal = -normal;
+      windows[b] = {normal, std::sqrt(std::max(0.0, solver.eigenvalues()(0))), true};
+    }
+    return windows;
+  }
+
+  // Faces grown from the flattest windows over neighbours whose windows turn less than
+  // κ / 3 (8.3°) from the face's mean: between the cinder faces' 13° and what one surface's
+  // windows turn by where it is warped or layered (room_scan2's wall x-2.55: pieces 0.5-5°
+  // apart; office1's far wall: layers 1.8° apart).
+  std::vector<Face> grownFaces(const std::vector<Window>& windows) const {
+    std::vector<std::size_t> order;
+    for (std::size_t b = 0; b < blocks_.size(); ++b)
+      if (windows[b].valid) order.push_back(b);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return windows[a].rms < windows[b].rms; });
+    std::vector<int> face_of(blocks_.size(), -1);
+    std::vector<Face> faces;
+    for (const std::size_t seed : order) {
+      if (face_of[seed] >= 0) continue;
+      Face face;
+      Eigen::Vector3d sum = windows[seed].normal;
+      const int id = static_cast<int>(faces.size());
+      face_of[seed] = id;
+      std::vector<std::size_t> queue{seed};
+      for (std::size_t q = 0; q < queue.size(); ++q) {
+        face.members.push_back(queue[q]);
+        const Eigen::Vector3d mean = sum.normalized();
+        forNeighbours(queue[q], [&](std::size_t o) {
+          if (face_of[o] >= 0 || !windows[o].valid || angleBetween(windows[o].normal, mean) > grow_) return;
+          face_of[o] = id;
+          sum += windows[o].normal;
+          queue.push_back(o);
+        });
+      }
+      faces.push_back(std::move(face));
+    }
+    return faces;
+  }
+
+  bool tooSmall(const std::vector<std::size_t>& members) const {
+    return members.size() < static_cast<std::size_t>(config_.min_blocks) ||
+           surfaceOf(members) * cell_area_ < kFaceShare * config_.min_area;
+  }
+
+  // The faces large enough, fitted to their own blocks' points.
+  std::vector<Face> largeFaces(std::vector<Face> faces) const {
+    std::vector<Face> large;
+    for (Face& face : faces) {
+      if (tooSmall(face.members)) continue;
+      for (const std::size_t b : face.members) face.points.add(stats_[b], centres_[b]);
+      // Its points spread across the face both ways (a row of blocks along one scan line
+      // fits any plane through the line) ...
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+      solver.computeDirect(face.points.covariance());
+      if (solver.eigenvalues()(1) < std::pow(kFaceSpreadCells * grid_.cellSize(), 2)) continue;
+      // ... and off its plane by about the noise: points of one or two scan lines lie in the
+      // scanner's sweep plane whatever the surface (room_scan2's wall x-2.55 at 5 cm: 12
+      // points, RMS 0, 61° off the wall).
+      if (solver.eigenvalues()(0) < std::pow(config_.noise / 3.0, 2)) continue;
+      fitFace(face);
+      large.push_back(std::move(face));
+    }
+    return large;
+  }
+
+  // Faces whose planes turn less than a window may are one: touching (a surface that
+  // bends or warps, a scanner's distortion, rather than creases) or on one plane (a face
+  // cut in two by a crease's windows).
+  void mergeTouchingOrCoplanar(std::vector<Face>& faces) const {
+    std::vector<int> face_of(blocks_.size(), -1);
+    for (std::size_t f = 0; f < faces.size(); ++f)
+      for (const std::size_t b : faces[f].members) face_of[b] = static_cast<int>(f);
+    for (std::size_t a = 0; a < faces.size(); ++a) {
+      for (std::size_t b = a + 1; b < faces.size();) {
+        const bool coplanar = std::abs(faces[a].normal.dot(faces[b].point - faces[a].point)) <= config_.epsilon &&
+                              std::abs(faces[b].normal.dot(faces[a].point - faces[b].point)) <= config_.epsilon;
+        if (angleBetween(faces[a].normal, faces[b].normal) > grow_ ||
+            !(coplanar || touches(faces[a].members, face_of, b))) {
+          ++b;
+          continue;
+        }
+        for (const std::size_t m : faces[b].members) face_of[m] = static_cast<int>(a);
+        faces[a].points.merge(faces[b].points);
+        faces[a].members.insert(faces[a].members.end(), faces[b].members.begin(), faces[b].members.end());
+        fitFace(faces[a]);
+        faces.erase(faces.begin() + static_cast<std::ptrdiff_t>(b));
+        for (int& f : face_of)
+          if (f > static_cast<int>(b)) --f;
+        b = a + 1;
+      }
+    }
+  }
+
+  // Every block to the face its points lie nearest (`members`, and per face its members'
+  // points' squared residuals). A face left with less than a face needs (a rim's windows,
+  // a corner, a depth camera's clutter) gives its blocks to the others; faces that then
+  // touch and turn less than a window may are one surface in layers or warped (a depth
+  // camera's wall: two layers 16 cm apart that the windows had kept apart), fitted to the
+  // blocks both took.
+  void assign(std::vector<Face>& faces, std::vector<std::vector<std::size_t>>& members,
+              std::vector<double>& squared) const {
+    while (faces.size() >= 2) {
+      members.assign(faces.size(), {});
+      squared.assign(faces.size(), 0.0);
+      for (std::size_t b = 0; b < blocks_.size(); ++b) {
+        if (stats_[b].empty()) continue;
+        std::size_t best = 0;
+        double best_squared = std::numeric_limits<double>::infinity();
+        for (std::size_t f = 0; f < faces.size(); ++f) {
+          const double mean_squared = meanSquared(stats_[b], centres_[b], faces[f].normal, faces[f].point);
+          if (mean_squared < best_squared) best = f, best_squared = mean_squared;
+        }
+        // A block whose points lie off every face by more than 3 σ (RMS) is on none: a
+        // cinder block's side, a crease's cell at 10 cm (neither counts for or against).
+        if (best_squared > std::pow(3.0 * config_.noise, 2)) continue;
+        members[best].push_back(b);
+        squared[best] += stats_[b].count * best_squared;
+      }
+      // The smallest of the faces too small.
+      std::size_t smallest = faces.size();
+      for (std::size_t f = 0; f < faces.size(); ++f) {
+        if (tooSmall(members[f]) && (smallest == faces.size() || surfaceOf(members[f]) < surfaceOf(members[smallest])))
+          smallest = f;
+      }
+      if (smallest < faces.size()) {
+        faces.erase(faces.begin() + static_cast<std::ptrdiff_t>(smallest));
         continue;
       }
-      for (const std::size_t m : large[b].members) large_of[m] = static_cast<int>(a);
-      large[a].points.merge(large[b].points);
-      large[a].members.insert(large[a].members.end(), large[b].members.begin(), large[b].members.end());
-      fitFace(large[a]);
-      large.erase(large.begin() + static_cast<std::ptrdiff_t>(b));
-      for (int& f : large_of)
-        if (f > static_cast<int>(b)) --f;
-      b = a + 1;
+      const std::vector<int> face_of = faceOfBlocks(members);
+      bool merged = false;
+      for (std::size_t a = 0; a < faces.size() && !merged; ++a) {
+        for (std::size_t b = a + 1; b < faces.size() && !merged; ++b) {
+          if (angleBetween(faces[a].normal, faces[b].normal) > grow_ || !touches(members[a], face_of, b)) continue;
+          faces[a].points = PointMoments{};
+          for (const std::size_t f : {a, b})
+            for (const std::size_t m : members[f]) faces[a].points.add(stats_[m], centres_[m]);
+          fitFace(faces[a]);
+          faces.erase(faces.begin() + static_cast<std::ptrdiff_t>(b));
+          merged = true;
+        }
+      }
+      if (!merged) break;
     }
   }
-  // Every block to the face its points lie nearest. A face left with less than a face needs
-  // (a rim's windows, a corner, a depth camera's clutter) gives its blocks to the others.
-  const Eigen::Vector3d patch_point = -(plane.normal.dot(origin) + plane.offset) * plane.normal;
-  std::vector<std::vector<std::size_t>> members;
-  std::vector<double> squared;  // per face, its members' points' squared residuals
-  while (large.size() >= 2) {
-    members.assign(large.size(), {});
-    squared.assign(large.size(), 0.0);
-    for (std::size_t b = 0; b < count; ++b) {
-      if (stats[b].empty()) continue;
-      std::size_t best = 0;
-      double best_squared = std::numeric_limits<double>::infinity();
-      for (std::size_t f = 0; f < large.size(); ++f) {
-        const double mean_squared = meanSquared(stats[b], centres[b], large[f].normal, large[f].point);
-        if (mean_squared < best_squared) best = f, best_squared = mean_squared;
-      }
-      // A block whose points lie off every face by more than 3 σ (RMS) is on none: a
-      // cinder block's side, a crease's cell at 10 cm (neither counts for or against).
-      if (best_squared > std::pow(3.0 * config.noise, 2)) continue;
-      members[best].push_back(b);
-      squared[best] += stats[b].count * best_squared;
-    }
-    std::vector<double> surfaces(large.size(), 0.0);
-    for (std::size_t f = 0; f < large.size(); ++f)
-      for (const std::size_t b : members[f]) surfaces[f] += grid.blocks()[blocks[b]].surface;
-    // The smallest of the faces too small.
-    std::size_t smallest = large.size();
-    for (std::size_t f = 0; f < large.size(); ++f) {
-      const bool small = members[f].size() < static_cast<std::size_t>(config.min_blocks) ||
-                         surfaces[f] * cell_area < kFaceShare * config.min_area;
-      if (small && (smallest == large.size() || surfaces[f] < surfaces[smallest])) smallest = f;
-    }
-    if (smallest < large.size()) {
-      large.erase(large.begin() + static_cast<std::ptrdiff_t>(smallest));
-      continue;
-    }
-    // Faces that now touch and turn less than a window may are one surface in layers or
-    // warped (a depth camera's wall: two layers 16 cm apart that the windows had kept
-    // apart): one face, fitted to the blocks both took.
-    std::vector<int> face_of(count, -1);
-    for (std::size_t f = 0; f < large.size(); ++f)
+
+  std::vector<int> faceOfBlocks(const std::vector<std::vector<std::size_t>>& members) const {
+    std::vector<int> face_of(blocks_.size(), -1);
+    for (std::size_t f = 0; f < members.size(); ++f)
       for (const std::size_t b : members[f]) face_of[b] = static_cast<int>(f);
-    bool merged = false;
-    for (std::size_t a = 0; a < large.size() && !merged; ++a) {
-      for (std::size_t b = a + 1; b < large.size() && !merged; ++b) {
-        if (angleBetween(large[a].normal, large[b].normal) > grow || !touches(members[a], face_of, b)) continue;
-        large[a].points = PointMoments{};
-        for (const std::size_t f : {a, b})
-          for (const std::size_t m : members[f]) large[a].points.add(stats[m], centres[m]);
-        fitFace(large[a]);
-        large.erase(large.begin() + static_cast<std::ptrdiff_t>(b));
-        merged = true;
-      }
-    }
-    if (!merged) break;
+    return face_of;
   }
-  if (large.size() < 2) return {};
+
   // A crease: two touching faces that turn more than a window may. Faces all within that
   // of each other are parallel layers or one warped surface, not creased (room_scan2's
   // wall x-2.55, warped by ±10 cm: pieces 0.5-5° apart and 5-10 cm off each other).
-  std::vector<int> assigned(count, -1);
-  for (std::size_t f = 0; f < large.size(); ++f)
-    for (const std::size_t b : members[f]) assigned[b] = static_cast<int>(f);
-  bool creased = false;
-  for (std::size_t a = 0; a < large.size() && !creased; ++a)
-    for (std::size_t b = a + 1; b < large.size() && !creased; ++b)
-      creased = angleBetween(large[a].normal, large[b].normal) > grow && touches(members[a], assigned, b);
-  if (!creased) return {};
+  bool creased(const std::vector<Face>& faces, const std::vector<std::vector<std::size_t>>& members) const {
+    const std::vector<int> face_of = faceOfBlocks(members);
+    for (std::size_t a = 0; a < faces.size(); ++a)
+      for (std::size_t b = a + 1; b < faces.size(); ++b)
+        if (angleBetween(faces[a].normal, faces[b].normal) > grow_ && touches(members[a], face_of, b)) return true;
+    return false;
+  }
+
   // The split stands when the faces' squared residuals are at most a quarter of the one
-  // plane's over the same blocks ...
-  double one = 0.0;
-  for (const std::vector<std::size_t>& face : members)
-    for (const std::size_t b : face) one += stats[b].count * meanSquared(stats[b], centres[b], plane.normal, patch_point);
-  const double split = std::accumulate(squared.begin(), squared.end(), 0.0);
-  if (!(split <= kSplitGain * one)) return {};
-  // ... and the faces hold most of the patch's points: where over 15 % lie off every face
-  // (a depth camera's layered wall: 34 %; ANYmal's treads and risers of a 2 cm elevation
-  // map: 24 %) the faces are not what the patch is made of (the cinder blocks at 10 cm
-  // cells: 10 %, at 5 cm 2.5 %).
-  double all = 0.0;
-  double on_faces = 0.0;
-  for (std::size_t b = 0; b < count; ++b) all += stats[b].count;
-  for (const std::vector<std::size_t>& face : members)
-    for (const std::size_t b : face) on_faces += stats[b].count;
-  if (on_faces < (1.0 - kOffFaces) * all) return {};
-  return members;
-}
+  // plane's over the same blocks, and the faces hold most of the patch's points: where over
+  // 15 % lie off every face (a depth camera's layered wall: 34 %; ANYmal's treads and risers
+  // of a 2 cm elevation map: 24 %) the faces are not what the patch is made of (the cinder
+  // blocks at 10 cm cells: 10 %, at 5 cm 2.5 %).
+  bool explained(const std::vector<std::vector<std::size_t>>& members, const std::vector<double>& squared) const {
+    double one = 0.0;
+    double on_faces = 0.0;
+    for (const std::vector<std::size_t>& face : members) {
+      for (const std::size_t b : face) {
+        one += stats_[b].count * meanSquared(stats_[b], centres_[b], plane_.normal, patch_point_);
+        on_faces += stats_[b].count;
+      }
+    }
+    const double split = std::accumulate(squared.begin(), squared.end(), 0.0);
+    if (!(split <= kSplitGain * one)) return false;
+    double all = 0.0;
+    for (const PointStats& stats : stats_) all += stats.count;
+    return on_faces >= (1.0 - kOffFaces) * all;
+  }
+
+  const BlockGrid& grid_;
+  const PatchSet& set_;
+  const std::vector<std::uint32_t>& blocks_;
+  const Plane& plane_;
+  std::int32_t label_;
+  const CreaseConfig& config_;
+  double grow_;
+  double cell_area_;
+  std::vector<PointStats> stats_;
+  std::vector<Eigen::Vector3d> centres_;  // the blocks' point-stats frames, about the patch's centroid
+  std::unordered_map<std::uint32_t, std::size_t> index_;  // block id -> index here
+  Eigen::Vector3d patch_point_;  // a point on the patch's plane, about its centroid
+};
 
 }  // namespace
 
@@ -283,7 +338,7 @@ std::vector<int> splitCreases(const BlockGrid& grid, PatchSet& set, const Crease
     if (!(plane.rms > kRoughSigmas * config.noise) || set.blocks[k].size() < 2 * static_cast<std::size_t>(config.min_blocks))
       continue;
     if (grid.pointsOf(set.blocks[k].front()).empty()) return split;  // a map without point moments
-    const std::vector<std::vector<std::size_t>> faces = facesOf(grid, set, k, config);
+    const std::vector<std::vector<std::size_t>> faces = PatchFaces(grid, set, k, config).find();
     if (faces.empty()) continue;
     const std::vector<std::uint32_t> blocks = set.blocks[k];
     const Plane original = set.planes[k];
