@@ -14,6 +14,7 @@
 #include "../src/planes/patch_merges.hpp"
 #include "mlmap/planes/block_grid.hpp"
 #include "mlmap/planes/ermsm.hpp"
+#include "patch_pieces.hpp"
 #include "plane_scenes.hpp"
 
 using namespace mlmap;
@@ -78,18 +79,8 @@ PatchSet piecesAlongX(const BlockGrid& grid, const std::vector<double>& cuts, do
     const double x = grid.blocks()[id].point.x();
     pieces[static_cast<std::size_t>(std::upper_bound(cuts.begin(), cuts.end(), x) - cuts.begin())].push_back(id);
   }
-  for (std::vector<std::uint32_t>& blocks : pieces) {
-    Patch patch;
-    patch.blocks = std::move(blocks);
-    const CandidatePlane reference{Eigen::Vector3f::UnitZ(), grid.blocks()[patch.blocks.front()].point};
-    Plane plane = describePatch(grid, patch, reference, 25.0 * std::numbers::pi / 180.0, noise);
-    plane.id = static_cast<std::int32_t>(set.planes.size() + 1);
-    for (const std::uint32_t id : patch.blocks) set.labels[id] = plane.id;
-    set.planes.push_back(plane);
-    set.blocks.push_back(patch.blocks);
-    set.outline_frames.push_back(OutlineFrame{plane.normal, plane.centroid, true});
-    set.outline_runs.emplace_back();
-  }
+  for (std::vector<std::uint32_t>& blocks : pieces)
+    test::addPatch(grid, set, std::move(blocks), Eigen::Vector3f::UnitZ(), 25.0 * std::numbers::pi / 180.0, noise);
   return set;
 }
 

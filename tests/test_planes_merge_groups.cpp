@@ -10,6 +10,7 @@
 
 #include "../src/planes/patch_merges.hpp"
 #include "mlmap/planes/block_grid.hpp"
+#include "patch_pieces.hpp"
 #include "plane_scenes.hpp"
 
 using namespace mlmap;
@@ -32,19 +33,8 @@ PatchSet threePieces(const BlockGrid& grid) {
     pieces[piece].push_back(id);
   }
   for (std::size_t k = 0; k < pieces.size(); ++k) {
-    Patch patch;
-    patch.blocks = pieces[k];
-    for (const std::uint32_t id : patch.blocks) patch.surface += grid.blocks()[id].surface;
-    const PlaneBlock& first = grid.blocks()[patch.blocks.front()];
-    const CandidatePlane reference{k == 2 ? Eigen::Vector3f(-0.17F, 0.0F, 0.985F).normalized() : Eigen::Vector3f::UnitZ(),
-                                   first.point};
-    Plane plane = describePatch(grid, patch, reference, kKappa, kNoise);
-    plane.id = static_cast<std::int32_t>(k + 1);
-    for (const std::uint32_t id : patch.blocks) set.labels[id] = plane.id;
-    set.planes.push_back(plane);
-    set.blocks.push_back(patch.blocks);
-    set.outline_frames.push_back(OutlineFrame{plane.normal, plane.centroid, true});
-    set.outline_runs.emplace_back();
+    const Eigen::Vector3f normal = k == 2 ? Eigen::Vector3f(-0.17F, 0.0F, 0.985F).normalized() : Eigen::Vector3f::UnitZ();
+    test::addPatch(grid, set, pieces[k], normal, kKappa, kNoise);
   }
   return set;
 }

@@ -34,6 +34,13 @@ constexpr double kFaceSpreadCells = 0.5;
 constexpr double kWindowPoints = 8.0;
 constexpr double kWindowSpreadCells = 0.25;
 
+// Whether blocks of this many and this surface (surface units) are too few for a face:
+// under the patch minimum in blocks, or under kFaceShare of its minimum area.
+bool tooSmallForFace(std::size_t blocks, double surface, double cell_size, const CreaseConfig& config) {
+  return blocks < static_cast<std::size_t>(config.min_blocks) ||
+         surface * cell_size * cell_size < kFaceShare * config.min_area;
+}
+
 struct Window {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   double rms = 0.0;
@@ -71,7 +78,7 @@ class PatchFaces {
  public:
   PatchFaces(const BlockGrid& grid, const PatchSet& set, std::size_t k, const CreaseConfig& config)
       : grid_(grid), set_(set), blocks_(set.blocks[k]), plane_(set.planes[k]), label_(static_cast<std::int32_t>(k + 1)),
-        config_(config), grow_(config.kappa_rad / 3.0), cell_area_(grid.cellSize() * grid.cellSize()),
+        config_(config), grow_(config.kappa_rad / 3.0),
         stats_(blocks_.size()), centres_(blocks_.size()) {
     const Eigen::Vector3d origin = plane_.centroid;
     index_.reserve(blocks_.size());
@@ -169,8 +176,7 @@ class PatchFaces {
   }
 
   bool tooSmall(const std::vector<std::size_t>& members) const {
-    return members.size() < static_cast<std::size_t>(config_.min_blocks) ||
-           surfaceOf(members) * cell_area_ < kFaceShare * config_.min_area;
+    return tooSmallForFace(members.size(), surfaceOf(members), grid_.cellSize(), config_);
   }
 
   // The faces large enough, fitted to their own blocks' points.
@@ -320,7 +326,6 @@ class PatchFaces {
   std::int32_t label_;
   const CreaseConfig& config_;
   double grow_;
-  double cell_area_;
   std::vector<PointStats> stats_;
   std::vector<Eigen::Vector3d> centres_;  // the blocks' point-stats frames, about the patch's centroid
   std::unordered_map<std::uint32_t, std::size_t> index_;  // block id -> index here
@@ -354,12 +359,7 @@ std::vector<int> splitCreases(const BlockGrid& grid, PatchSet& set, const Crease
       const CandidatePlane reference{original.normal.cast<float>(), original.centroid.cast<float>()};
       const Plane fitted = describePatch(grid, whole, reference, config.kappa_rad, config.noise);
       for (Patch& piece : splitIntoPatches(grid, ids, fitted.normal, fitted.centroid)) {
-        double surface = 0.0;
-        for (const std::uint32_t id : piece.blocks) surface += grid.blocks()[id].surface;
-        piece.surface = surface;
-        const bool large = piece.blocks.size() >= static_cast<std::size_t>(config.min_blocks) &&
-                           surface * grid.cellSize() * grid.cellSize() >= kFaceShare * config.min_area;
-        if (!large) {
+        if (tooSmallForFace(piece.blocks.size(), piece.surface, grid.cellSize(), config)) {
           for (const std::uint32_t id : piece.blocks) set.labels[id] = 0;
           continue;
         }
