@@ -136,7 +136,7 @@ void addPlanesCommand(CLI::App& app, Context& context) {
             Bound::Open, 90.0)
       ->capture_default_str();
   addNumber(command, "--sparse-gap", config.sparse_gap,
-            "Blocks of a surface's sparse parts (no direction) join its patch across gaps up to this, m; 0 = off", 0.0,
+            "Blocks of a surface's sparse parts (no direction) join its patch across gaps up to this, and sparse surfaces no patch reached are searched with neighbourhoods of it, m; 0 = off", 0.0,
             Bound::Closed, 10.0)
       ->capture_default_str();
   addNumber(command, "--max-candidates", config.max_candidates, "Max_cp: candidates in all", 1, Bound::Closed)

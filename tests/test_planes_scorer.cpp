@@ -287,9 +287,15 @@ TEST_CASE("eRMSM: a wall seen by scan lines 12 cm apart at 5 cm cells is found, 
       if (plane.label == PlaneClass::Wall) found.push_back(plane);
     return found;
   };
+  // Neither ladders nor the sparse search (sparse_search.hpp, which measures its
+  // neighbourhoods in metres and so finds the lines without ladders): no wall.
   ErmsmConfig without;
   without.ladder_gap = 0.0;
+  without.sparse_gap = 0.0;
   CHECK(walls(detectPlanes(map, without)).empty());
+  ErmsmConfig sparse_only;
+  sparse_only.ladder_gap = 0.0;
+  CHECK(walls(detectPlanes(map, sparse_only)).size() == 1);
   const std::vector<Plane> found = walls(detectPlanes(map));
   REQUIRE(found.size() == 1);
   CHECK(std::abs(found[0].normal.x()) > std::cos(1.0 * M_PI / 180.0));

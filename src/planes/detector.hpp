@@ -22,6 +22,7 @@
 #include "patch_set.hpp"
 #include "plane_scorer.hpp"
 #include "sparse_growth.hpp"
+#include "sparse_search.hpp"
 
 namespace mlmap {
 
@@ -96,7 +97,8 @@ class Detector {
   };
   std::vector<Undescribed> undescribed_;
   void describePatches();
-  void growIntoSparse();
+  void growIntoSparse(std::size_t first);
+  void findSparse();
 };
 
 }  // namespace mlmap

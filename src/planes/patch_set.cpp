@@ -30,12 +30,21 @@ void placeOutline(Plane& plane, const std::vector<Eigen::Vector3d>& corners) {
 // crosses √2 cells per cell of its length. Each block stands for its cell: on a level
 // plane the cells are counted (over |n_z| for its slope); on any other its cell's
 // extent along the plane's level axis u times its own extent up the plane (v) is a
-// rectangle, and the area of the rectangles' union is swept along u.
+// rectangle, and the area of the rectangles' union is swept along u. With `step` > 1
+// (Patch::raster_step) each block stands for a cell `step` cells wide.
 double coveredArea(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
-                   const Eigen::Vector3d& point) {
-  const double cell = grid.cellSize();
+                   const Eigen::Vector3d& point, int step) {
+  const double cell = grid.cellSize() * step;
   if (blocks.empty()) return 0.0;
   if (Eigen::Vector3d::UnitZ().cross(normal).norm() < RasterFrame::kLevelSine) {
+    if (step > 1) {
+      const auto divide = [step](std::int64_t a) { return a >= 0 ? a / step : -((-a + step - 1) / step); };
+      std::vector<std::pair<std::int64_t, std::int64_t>> cells;
+      for (const std::uint32_t id : blocks) cells.emplace_back(divide(grid.blocks()[id].cell.i), divide(grid.blocks()[id].cell.j));
+      std::sort(cells.begin(), cells.end());
+      const auto distinct = static_cast<double>(std::unique(cells.begin(), cells.end()) - cells.begin());
+      return distinct * cell * cell / std::abs(normal.z());
+    }
     // Block ids run row by row over the grid, a cell's blocks together: a cell's
     // blocks in the patch are consecutive in its ascending list.
     double distinct = 0.0;
@@ -180,7 +189,7 @@ Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePl
   plane.normal = normal;
   plane.offset = -normal.dot(point);
   plane.centroid = centroid / static_cast<double>(patch.blocks.size());
-  plane.area = coveredArea(grid, patch.blocks, normal, point);
+  plane.area = coveredArea(grid, patch.blocks, normal, point, std::max(patch.raster_step, 1));
   plane.block_count = patch.blocks.size();
   if (points_rms) {
     plane.rms = *points_rms;
@@ -235,7 +244,7 @@ void tracePendingOutlines(const BlockGrid& grid, PatchSet& set, int threads) {
     const std::size_t k = pending[static_cast<std::size_t>(n)];
     OutlineFrame& frame = set.outline_frames[k];
     std::vector<Segment>& runs = set.outline_runs[k];
-    placeOutline(set.planes[k], runs.empty() ? outlineOf(grid, set.blocks[k], frame.normal, frame.point)
+    placeOutline(set.planes[k], runs.empty() ? outlineOf(grid, set.blocks[k], frame.normal, frame.point, frame.step)
                                              : outlineOfRuns(runs, grid.cellSize(), frame.normal, frame.point));
     frame.pending = false;
     runs = {};

@@ -21,6 +21,7 @@ struct OutlineFrame {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   bool pending = true;
+  int step = 1;  // cells per raster cell (Patch::raster_step)
 };
 
 struct PatchSet {

@@ -16,6 +16,8 @@ namespace {
 // Planes of fewer blocks are rasterised on one thread.
 constexpr std::size_t kParallelBlocks = 20000;
 
+std::int32_t floorDivide(std::int32_t a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
 class DisjointSets {
  public:
   explicit DisjointSets(std::size_t count) : parent_(count) {
@@ -43,8 +45,9 @@ class DisjointSets {
 struct Footprints {
   FillVector<Segment> segments;
 
+  // `step`: cells of the grid per raster cell (the frame's cell size is step cells).
   Footprints(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const RasterFrame& frame,
-             int threads = 1)
+             int threads = 1, int step = 1)
       : segments(blocks.size()) {
     const auto count = static_cast<std::int64_t>(blocks.size());
     [[maybe_unused]] const bool parallel = threads > 1 && blocks.size() >= kParallelBlocks;
@@ -52,11 +55,13 @@ struct Footprints {
 #pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (parallel)
       for (std::int64_t k = 0; k < count; ++k) {
         const CellIndex cell = grid.blocks()[blocks[static_cast<std::size_t>(k)]].cell;
-        segments[static_cast<std::size_t>(k)] = {cell.i, cell.j, cell.j};
+        const std::int32_t u = floorDivide(cell.i, step);
+        const std::int32_t v = floorDivide(cell.j, step);
+        segments[static_cast<std::size_t>(k)] = {u, v, v};
       }
       return;
     }
-    const double cell = grid.cellSize();
+    const double cell = frame.cell_size;
     auto cellOf = [&](const Eigen::Vector3d& p) {
       const Eigen::Vector3d relative = p - frame.point;
       return Eigen::Vector2i(static_cast<std::int32_t>(std::floor(relative.dot(frame.u_axis) / cell)),
@@ -300,11 +305,13 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
 }
 
 std::vector<Eigen::Vector3d> outlineOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
-                                       const Eigen::Vector3d& normal, const Eigen::Vector3d& point) {
+                                       const Eigen::Vector3d& normal, const Eigen::Vector3d& point, int step) {
   if (blocks.empty()) return {};
+  step = std::max(step, 1);
+  const double raster_cell = grid.cellSize() * step;
   return outlineOfRuns(
-      ColumnRuns(Footprints(grid, blocks, RasterFrame(normal, point, grid.cellSize())).segments, 1).runs,
-      grid.cellSize(), normal, point);
+      ColumnRuns(Footprints(grid, blocks, RasterFrame(normal, point, raster_cell), 1, step).segments, 1).runs,
+      raster_cell, normal, point);
 }
 
 }  // namespace mlmap

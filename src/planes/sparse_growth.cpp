@@ -183,9 +183,9 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
 
 void growPatches(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions, const PlaneScorer& scorer,
                  const std::vector<CandidatePlane>& references, std::vector<double>& surfaces, PatchSet& set,
-                 const SparseGrowth& config) {
+                 const SparseGrowth& config, std::size_t first) {
   const float cos_edge = edgeCosine(config.kappa_rad);
-  for (std::size_t k = 0; k < set.planes.size(); ++k) {
+  for (std::size_t k = first; k < set.planes.size(); ++k) {
     const CandidatePlane& reference = references[k];
     const float band = scorer.bandOf(reference);
     // The untaken blocks within the band, matching or not (ascending), but those an

@@ -36,11 +36,11 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
                                         const std::vector<std::uint32_t>& patch, const CandidatePlane& plane,
                                         double epsilon, const SparseGrowth& config);
 
-// Grows each patch of `set` in turn (patch k split on references[k]; blocks another patch
-// grew into are no longer free): labels its new blocks, adds their surface to surfaces[k]
-// and leaves its outline to be rasterised again.
+// Grows each patch of `set` from index `first` on in turn (patch k split on references[k];
+// blocks another patch grew into are no longer free): labels its new blocks, adds their
+// surface to surfaces[k] and leaves its outline to be rasterised again.
 void growPatches(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions, const PlaneScorer& scorer,
                  const std::vector<CandidatePlane>& references, std::vector<double>& surfaces, PatchSet& set,
-                 const SparseGrowth& config);
+                 const SparseGrowth& config, std::size_t first = 0);
 
 }  // namespace mlmap

@@ -68,6 +68,9 @@ struct ErmsmConfig {
   // 0.6: the widest scan-line spacing on the floors of PCL's two room scans 5-7 m out
   // (0.35-0.7 m); on bench/real_data.py 0.4 found 35 / 32 of 64 surfaces (5 / 10 cm
   // cells), 0.6 35 / 34 (Bobkov's room 2: its wall x-1.71 at 10 cm 31 -> 92 %), 1.0 no more.
+  // Then the sparse surfaces no patch reached are searched with neighbourhoods of it
+  // (sparse_search.hpp: a block's local plane from those within half of it, a region
+  // grown across it).
   double sparse_gap = 0.6;
   int max_candidates = 4000;      // Max_cp: Algorithm 1 stops after this many candidates
   int max_idle_candidates = 300;  // ... or after this many without an accepted plane

@@ -15,6 +15,9 @@ struct Patch {
   std::vector<std::uint32_t> blocks;       // block ids, ascending
   double surface = 0.0;                    // surface units
   std::vector<Eigen::Vector3d> outline;    // m, outer boundary on the plane, counter-clockwise about the normal
+  // Cells per raster cell of its area and outline: 1, or more for a surface sampled
+  // sparser than the grid (sparse_search.hpp), whose blocks would cover their cells only.
+  int raster_step = 1;
 };
 
 // A basis (u, v) of the plane with u × v = normal: u horizontal when the plane is not,
@@ -32,7 +35,8 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
 
 // The outline of the blocks on the plane through `point`: the boundary loop of their
 // raster cells enclosing the most area, counter-clockwise about the normal, corners only.
+// `step`: cells per raster cell (Patch::raster_step).
 std::vector<Eigen::Vector3d> outlineOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
-                                       const Eigen::Vector3d& normal, const Eigen::Vector3d& point);
+                                       const Eigen::Vector3d& normal, const Eigen::Vector3d& point, int step = 1);
 
 }  // namespace mlmap
