@@ -126,8 +126,15 @@ def score(labels, owner, points, planes, annotation):
     unmarked = on_patch & (owner < 0)
     # A patch lies on no marked surface when most of its points are outside every one.
     stray = [p for p in np.unique(labels[on_patch]) if np.mean(owner[labels == p] < 0) > 0.5]
+    # Of those, the ones that are no flat surface (issue 19: "points on unmarked patches that
+    # are not flat surfaces: none"): their points' RMS to the patch's plane more than twice
+    # the median own-fit RMS of the scan's marked surfaces (its flat surfaces' roughness).
+    own_rms = [row["own"] for row in rows if row["points"] >= 3 and not math.isnan(row["own"])]
+    flat_rms = float(np.median(own_rms)) if own_rms else float("inf")
+    rough = [p for p in stray if p in planes and
+             real_annotations.rms_to_plane(points[labels == p], *planes[p]) > 2.0 * flat_rms]
     return rows, dict(on_patch=int(on_patch.sum()), unmarked=int(unmarked.sum()), patches=len(np.unique(labels[on_patch])),
-                      stray_patches=len(stray), stray_points=int(np.isin(labels, stray).sum()))
+                      stray_patches=len(stray), stray_points=int(np.isin(labels, stray).sum()), rough_strays=len(rough))
 
 
 def posed_options(pose_file, features):
@@ -211,8 +218,9 @@ def table(scene, annotation, results):
     lines.append("|---|" + "---|" * len(methods))
     lines.append("| surfaces found: >= 90 % (walls, floor, ceiling) or >= 70 % (the others) on a patch that joins no other | " + " | ".join(
         f"{passed(annotation, results[m]['rows'])}" for m in methods) + " |")
-    lines.append("| patches / on no marked surface | " + " | ".join(
-        f"{results[m]['extra']['patches']} / {results[m]['extra']['stray_patches']}" for m in methods) + " |")
+    lines.append("| patches / on no marked surface / of those not flat (RMS > 2x the marked surfaces' median) | " + " | ".join(
+        f"{results[m]['extra']['patches']} / {results[m]['extra']['stray_patches']} / {results[m]['extra']['rough_strays']}"
+        for m in methods) + " |")
     lines.append("| points on patches / outside marked surfaces | " + " | ".join(
         f"{results[m]['extra']['on_patch']} / {results[m]['extra']['unmarked']}" for m in methods) + " |")
     lines.append("| detection s (mlmap: planes, 2 threads; CGAL: normals + RANSAC) | " + " | ".join(
@@ -268,6 +276,8 @@ def totals_table(totals):
              "| RMS to the patch's plane within 0.5 cm of the points' own fit | " + " | ".join(
                  f"{t['rms_ok']} of {t['marked']}" for t in totals.values()) + " |",
              "| patches on no marked surface | " + " | ".join(str(t["stray"]) for t in totals.values()) + " |",
+             "| of those not flat (points' RMS to the patch > 2x the scan's marked surfaces' median) | " + " | ".join(
+                 str(t["rough"]) for t in totals.values()) + " |",
              "| detection s, sum | " + " | ".join(f"{t['detect_s']:.2f}" for t in totals.values()) + " |"]
     return "\n".join(lines) + "\n"
 
@@ -420,13 +430,14 @@ def main():
         text = table(scene, annotation, results)
         for method, result in results.items():
             found, marked = found_count(annotation, result["rows"])
-            total = totals.setdefault(method, dict(found=0, marked=0, stray=0, detect_s=0.0, structural_found=0,
+            total = totals.setdefault(method, dict(found=0, marked=0, stray=0, rough=0, detect_s=0.0, structural_found=0,
                                                    structural=0, other_found=0, other=0, rms_ok=0))
             total["found"] += found
             total["marked"] += marked
             for key, count in issue_counts(annotation, result["rows"]).items():
                 total[key] += count
             total["stray"] += result["extra"]["stray_patches"]
+            total["rough"] += result["extra"]["rough_strays"]
             verdicts += [dict(scene=name, surface=surface["name"], method=method, found=bool(is_found(surface, row)))
                          for surface, row in zip(annotation["surfaces"], result["rows"])]
             total["detect_s"] += result["times"]["detect_s"]
