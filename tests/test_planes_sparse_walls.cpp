@@ -76,14 +76,11 @@ TEST_CASE("eRMSM: a far wall sampled 15 cm apart, with no patch beside it, is on
         CHECK(std::abs(plane.normal.dot(normal)) > std::cos(3.0 * std::numbers::pi / 180.0));
         CHECK(plane.rms < 0.02);
         CHECK(plane.label == PlaneClass::Wall);
-        // At 5 cm the sparse search's patch: its area and outline on a raster as coarse as
-        // its points' spacing, the wall it is (4 x 2.6 m), not the cells its blocks fill (486
-        // of them, 1.2 m²). (At 10 cm the search's own patch counts its cells: 5-8 m², a
-        // weakness the README lists.)
-        if (cell == 0.05) {
-          CHECK(plane.area > 0.8 * 4.0 * 2.6);
-          CHECK(plane.area < 1.3 * 4.0 * 2.6);
-        }
+        // Its area and outline on a raster as coarse as its points' spacing: the wall it is
+        // (4 x 2.6 m), not the cells its blocks fill (486 of them, 1.2 m² at 5 cm; 5-8 m² at
+        // 10 cm, where the search's own patch counted the cells its points fell in).
+        CHECK(plane.area > 0.8 * 4.0 * 2.6);
+        CHECK(plane.area < 1.3 * 4.0 * 2.6);
       }
       if (cell == 0.05) {
         // Without the sparse stages the wall is on no patch (as before).

@@ -9,6 +9,7 @@
 #include "mlmap/planes/direction_vectors.hpp"
 #include "pca_sums.hpp"
 #include "raster_frame.hpp"
+#include "raster_step.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -189,7 +190,7 @@ Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePl
   plane.normal = normal;
   plane.offset = -normal.dot(point);
   plane.centroid = centroid / static_cast<double>(patch.blocks.size());
-  plane.area = coveredArea(grid, patch.blocks, normal, point, std::max(patch.raster_step, 1));
+  plane.area = coveredArea(grid, patch.blocks, normal, point, std::max(patch.raster_step, spacingStep(grid, patch.blocks)));
   plane.block_count = patch.blocks.size();
   if (points_rms) {
     plane.rms = *points_rms;
@@ -244,8 +245,11 @@ void tracePendingOutlines(const BlockGrid& grid, PatchSet& set, int threads) {
     const std::size_t k = pending[static_cast<std::size_t>(n)];
     OutlineFrame& frame = set.outline_frames[k];
     std::vector<Segment>& runs = set.outline_runs[k];
-    placeOutline(set.planes[k], runs.empty() ? outlineOf(grid, set.blocks[k], frame.normal, frame.point, frame.step)
-                                             : outlineOfRuns(runs, grid.cellSize(), frame.normal, frame.point));
+    // The split's runs are on the grid's cells: a patch sampled sparser is traced again.
+    const int step = std::max(frame.step, spacingStep(grid, set.blocks[k]));
+    placeOutline(set.planes[k], runs.empty() || step > 1
+                                    ? outlineOf(grid, set.blocks[k], frame.normal, frame.point, step)
+                                    : outlineOfRuns(runs, grid.cellSize(), frame.normal, frame.point));
     frame.pending = false;
     runs = {};
   }
