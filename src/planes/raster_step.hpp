@@ -14,8 +14,9 @@
 namespace mlmap {
 
 // Cells per raster cell for the blocks `blocks` (ascending ids) of one patch: their median
-// distance to the nearest other block of theirs in cells, rounded, from 1 to 3 (a median
-// under 1.5 cells, a dense surface's, gives 1). Up to 1024 blocks, evenly spread, are asked.
+// distance to the nearest other block of theirs in cells (across between their points, up
+// between their extents), rounded, from 1 to 3 (a median
+// under 1.5 cells, a dense surface's, gives 1). Up to 256 blocks, evenly spread, are asked.
 int spacingStep(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks);
 
 }  // namespace mlmap
