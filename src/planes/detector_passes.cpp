@@ -61,7 +61,6 @@ void Detector::findSparse() {
   const SparseSearch search{.max_gap = config_.sparse_gap,
                             .epsilon = config_.epsilon,
                             .max_tilt_rad = radians(ClassifyConfig{}.horizontal_deg),
-                            .radius = config_.radius,
                             .ladder_gap = config_.ladder_gap,
                             .min_blocks = static_cast<std::size_t>(std::max(config_.min_patch_blocks, 1)),
                             .min_area = config_.min_patch_area};

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "mlmap/planes/direction_vectors.hpp"
+#include "floor_divide.hpp"
 #include "pca_sums.hpp"
 #include "raster_frame.hpp"
 #include "raster_step.hpp"
@@ -39,9 +40,10 @@ double coveredArea(const BlockGrid& grid, const std::vector<std::uint32_t>& bloc
   if (blocks.empty()) return 0.0;
   if (Eigen::Vector3d::UnitZ().cross(normal).norm() < RasterFrame::kLevelSine) {
     if (step > 1) {
-      const auto divide = [step](std::int64_t a) { return a >= 0 ? a / step : -((-a + step - 1) / step); };
       std::vector<std::pair<std::int64_t, std::int64_t>> cells;
-      for (const std::uint32_t id : blocks) cells.emplace_back(divide(grid.blocks()[id].cell.i), divide(grid.blocks()[id].cell.j));
+      for (const std::uint32_t id : blocks) {
+        cells.emplace_back(floorDivide(grid.blocks()[id].cell.i, step), floorDivide(grid.blocks()[id].cell.j, step));
+      }
       std::sort(cells.begin(), cells.end());
       const auto distinct = static_cast<double>(std::unique(cells.begin(), cells.end()) - cells.begin());
       return distinct * cell * cell / std::abs(normal.z());

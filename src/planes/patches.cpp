@@ -7,6 +7,7 @@
 
 #include "counting_sort.hpp"
 #include "fill_vector.hpp"
+#include "floor_divide.hpp"
 #include "outline_runs.hpp"
 #include "raster_frame.hpp"
 
@@ -15,8 +16,6 @@ namespace {
 
 // Planes of fewer blocks are rasterised on one thread.
 constexpr std::size_t kParallelBlocks = 20000;
-
-std::int32_t floorDivide(std::int32_t a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
 class DisjointSets {
  public:
@@ -55,8 +54,8 @@ struct Footprints {
 #pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (parallel)
       for (std::int64_t k = 0; k < count; ++k) {
         const CellIndex cell = grid.blocks()[blocks[static_cast<std::size_t>(k)]].cell;
-        const std::int32_t u = floorDivide(cell.i, step);
-        const std::int32_t v = floorDivide(cell.j, step);
+        const auto u = static_cast<std::int32_t>(floorDivide(cell.i, step));
+        const auto v = static_cast<std::int32_t>(floorDivide(cell.j, step));
         segments[static_cast<std::size_t>(k)] = {u, v, v};
       }
       return;

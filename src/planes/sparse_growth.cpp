@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "floor_divide.hpp"
 #include "id_set.hpp"
 #include "patch_rules.hpp"
 #include "seen_gaps.hpp"
@@ -62,6 +63,22 @@ bool seenPastBetween(const BlockGrid& grid, const GrowthPlane& plane, CellIndex 
 
 }  // namespace
 
+bool levelOrPlumb(const Eigen::Vector3d& normal, double max_tilt_rad) {
+  const double tilt = std::acos(std::min(1.0, std::abs(normal.z())));
+  return std::min(tilt, std::numbers::pi / 2 - tilt) <= max_tilt_rad;
+}
+
+bool isWallRung(const BlockGrid& grid, std::uint32_t id, double ladder_gap) {
+  const PlaneBlock& block = grid.blocks()[id];
+  bool rung = false;
+  grid.forEachInCells(block.cell.i, block.cell.i, block.cell.j, block.cell.j, [&](std::uint32_t other) {
+    if (other == id) return;
+    const PlaneBlock& near = grid.blocks()[other];
+    rung = rung || (near.bottom < block.top + ladder_gap && near.top > block.bottom - ladder_gap);
+  });
+  return rung;
+}
+
 std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                         const std::vector<std::uint32_t>& candidates,
                                         const std::vector<std::uint32_t>& patch, const CandidatePlane& reference,
@@ -70,8 +87,7 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
   // Only level and plumb planes: a tilted plane through sparse blocks is as likely the
   // envelope of a staircase's nosings (fr079's stair at 10 cm cells, 23°) as a ramp, and
   // grown it took every tread within its ε.
-  const double tilt = std::acos(std::min(1.0, static_cast<double>(std::abs(reference.normal.normalized().z()))));
-  if (std::min(tilt, std::numbers::pi / 2 - tilt) > config.max_tilt_rad) return {};
+  if (!levelOrPlumb(reference.normal.normalized().cast<double>(), config.max_tilt_rad)) return {};
   GrowthPlane plane{reference.normal.cast<double>().normalized(), reference.point.cast<double>(), epsilon,
                     std::abs(reference.normal.z()) >= std::cos(std::numbers::pi / 4.0), false};
   const float cos_edge = edgeCosine(config.kappa_rad);
@@ -82,16 +98,7 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
     // A level plane takes level blocks only, and no short block with another of its cell
     // less than a ladder gap above or below: that is a rung of a wall seen from afar (fr079
     // at 5 cm: a table's plane took 96 points of the wall beside it).
-    if (plane.level) {
-      if (block.vertical) continue;
-      bool rung = false;
-      grid.forEachInCells(block.cell.i, block.cell.i, block.cell.j, block.cell.j, [&](std::uint32_t other) {
-        if (other == id) return;
-        const PlaneBlock& near = grid.blocks()[other];
-        rung = rung || (near.bottom < block.top + config.ladder_gap && near.top > block.bottom - config.ladder_gap);
-      });
-      if (rung) continue;
-    }
+    if (plane.level && (block.vertical || isWallRung(grid, id, config.ladder_gap))) continue;
     const Eigen::Vector3f& direction = directions[id];
     if (direction.squaredNorm() > 0.0F && std::abs(direction.dot(reference.normal)) < cos_edge) continue;
     if (std::abs(plane.normal.dot(block.point.cast<double>() - plane.point)) >= epsilon) continue;
@@ -147,8 +154,7 @@ std::vector<std::uint32_t> sparseGrowth(const BlockGrid& grid, const std::vector
   // bucketed by squares of max_gap, so a step looks at nine buckets, not at every block
   // within max_gap.
   const auto bucket_of = [reach](CellIndex cell) {
-    const auto floor_div = [](std::int64_t a, std::int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); };
-    return std::pair<std::int64_t, std::int64_t>{floor_div(cell.i, reach), floor_div(cell.j, reach)};
+    return std::pair<std::int64_t, std::int64_t>{floorDivide(cell.i, reach), floorDivide(cell.j, reach)};
   };
   const auto key_of = [](std::int64_t bi, std::int64_t bj) { return (bi << 32) ^ (bj & 0xffffffffLL); };
   std::unordered_map<std::int64_t, std::vector<std::uint32_t>> buckets;

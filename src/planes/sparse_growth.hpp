@@ -17,6 +17,15 @@
 
 namespace mlmap {
 
+// Whether the unit `normal` lies within max_tilt_rad of level or of plumb (the classes'
+// floors, ceilings, tables and walls): the only planes sparse blocks join.
+bool levelOrPlumb(const Eigen::Vector3d& normal, double max_tilt_rad);
+
+// Whether block `id` is a rung of a wall seen from afar: a short block with another of
+// its cell less than `ladder_gap` above or below. No level plane takes one (fr079 at
+// 5 cm: a table's plane took 96 points of the wall beside it).
+bool isWallRung(const BlockGrid& grid, std::uint32_t id, double ladder_gap);
+
 struct SparseGrowth {
   double max_gap = 0.0;       // m, the longest step from block to block (in the plane)
   double kappa_rad = 0.0;     // blocks with a direction join within 2 κ of the plane's normal

@@ -11,6 +11,7 @@
 #include "median.hpp"
 #include "pca_sums.hpp"
 #include "smallest_axis.hpp"
+#include "sparse_growth.hpp"
 #include "unseen_gaps.hpp"
 
 namespace mlmap {
@@ -72,12 +73,6 @@ LocalPlane fitOf(const std::vector<Eigen::Vector3d>& points, const std::vector<s
   const SmallestAxis axis = smallestAxis(sums.covariance());
   return {axis.axis.normalized(), sums.mean() + origin, std::sqrt(axis.smallest_eigenvalue),
           std::sqrt(std::max(0.0, axis.middle_eigenvalue))};
-}
-
-// Within max_tilt of level or of plumb.
-bool levelOrPlumb(const Eigen::Vector3d& normal, double max_tilt) {
-  const double tilt = std::acos(std::min(1.0, std::abs(normal.z())));
-  return std::min(tilt, std::numbers::pi / 2 - tilt) <= max_tilt;
 }
 
 bool isLevel(const Eigen::Vector3d& normal) { return std::abs(normal.z()) >= std::cos(std::numbers::pi / 4); }
@@ -145,7 +140,7 @@ void joinWallPieces(const BlockGrid& grid, std::vector<SparseSurface>& surfaces,
 struct SparseBlocks {
   std::vector<std::uint32_t> ids;  // grid ids
   std::vector<Eigen::Vector3d> points;
-  std::vector<std::uint8_t> rungs;  // a short block with another of its cell within a ladder gap: part of a wall
+  std::vector<std::uint8_t> rungs;  // vertical, or a rung of a wall (isWallRung): no level region takes it
 };
 
 SparseBlocks sparseBlocks(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
@@ -164,14 +159,9 @@ SparseBlocks sparseBlocks(const BlockGrid& grid, const std::vector<Eigen::Vector
       });
       if (!alone) continue;
     }
-    bool rung = block.vertical;
-    grid.forEachInCells(block.cell.i, block.cell.i, block.cell.j, block.cell.j, [&](std::uint32_t other) {
-      const PlaneBlock& near = blocks[other];
-      rung = rung || (other != id && near.bottom < block.top + ladder_gap && near.top > block.bottom - ladder_gap);
-    });
     sparse.ids.push_back(id);
     sparse.points.push_back(block.point.cast<double>());
-    sparse.rungs.push_back(rung ? 1 : 0);
+    sparse.rungs.push_back(block.vertical || isWallRung(grid, id, ladder_gap) ? 1 : 0);
   }
   return sparse;
 }

@@ -25,7 +25,6 @@ struct SparseSearch {
   double max_gap = 0.0;       // m: neighbours further apart are not neighbours (ErmsmConfig::sparse_gap)
   double epsilon = 0.0;       // m: a region's blocks lie within this of its plane
   double max_tilt_rad = 0.0;  // only regions this close to level or to plumb
-  int radius = 2;             // cells: the direction window's; a region's spacing exceeds it
   double ladder_gap = 0.0;    // m: a level region takes no rung of a wall (as the sparse growth)
   std::size_t min_blocks = 6;
   double min_area = 0.0;      // m²: of its blocks' surface, as every patch (ErmsmConfig::min_patch_area)
