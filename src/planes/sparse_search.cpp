@@ -198,7 +198,10 @@ struct Neighbourhood {
 
 std::vector<SparseSurface> findSparseSurfaces(const BlockGrid& grid, const std::vector<Eigen::Vector3f>& directions,
                                               const std::vector<std::int32_t>& labels, const SparseSearch& config) {
-  if (!(config.max_gap > 0.0)) return {};
+  // A block's nearest neighbour counts within half the gap, and a region needs its blocks
+  // more than a cell apart: a gap of two cells or less can keep none (and a tiny one would
+  // make the index's buckets overflow its keys).
+  if (!(config.max_gap > 2.0 * grid.cellSize())) return {};
   const SparseBlocks sparse = sparseBlocks(grid, directions, labels, config.ladder_gap);
   const std::vector<Eigen::Vector3d>& points = sparse.points;
   if (points.size() < config.min_blocks) return {};
