@@ -10,6 +10,7 @@
 
 #include "bevels.hpp"
 #include "creases.hpp"
+#include "curved.hpp"
 #include "detector.hpp"
 #include "median.hpp"
 #include "mlmap/planes/block_grid.hpp"
@@ -201,6 +202,9 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   // level face on the ceiling's): the coplanar merge again, for patches parallel within
   // κ / 3, and never two faces of one split.
   if (sheets && hasPointStats(map)) {
+    // A strip of a pillar or a round wall is no plane (curved.hpp); before the crease
+    // split, which would cut it into faces.
+    dropCurved(grid, patches, radians(config.kappa_deg));
     const std::vector<int> faces_of = splitCreases(
         grid, patches,
         {config.noise, config.epsilon, radians(config.kappa_deg), config.min_patch_blocks, config.min_patch_area});
