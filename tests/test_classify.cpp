@@ -71,3 +71,26 @@ TEST_CASE("Classes: a level patch with the map's surface under it is no floor (a
   classifyPlanes(planes);
   CHECK(planes[0].label == PlaneClass::Floor);  // without samples, as before
 }
+
+TEST_CASE("Classes: a ceiling piece beyond a doorway, 9 cm off the ceiling's plane there, is ceiling; a fixture 40 cm below is not") {
+  // PCL's room_scan1: the next room's ceiling, seen through a door 4-5 m from the
+  // ceiling's centroid, lies 9 cm below the ceiling's plane there (the two lean 1.2° apart
+  // in a scan that is not quite flat); it was 'other'.
+  const Eigen::Vector3d up(0.0, 0.0, 1.0);
+  const double lean = 1.2 * std::numbers::pi / 180.0;
+  const Eigen::Vector3d leaning(std::sin(lean), 0.0, std::cos(lean));
+  std::vector<Plane> planes;
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.0}, 0.0, 6.0, 0.0, 4.0));          // floor
+  planes.push_back(levelPatch(leaning, {3.0, 2.0, 2.9}, 0.0, 6.0, 0.0, 4.0));     // ceiling
+  planes.push_back(levelPatch(up, {0.0, 0.0, 2.89}, 7.0, 9.0, 0.0, 4.0));         // beyond the door
+  planes.push_back(levelPatch(up, {0.0, 0.0, 2.45}, 2.0, 2.6, 1.0, 1.6));         // a lamp's underside
+  classifyPlanes(planes);
+  CHECK(planes[0].label == PlaneClass::Floor);
+  CHECK(planes[1].label == PlaneClass::Ceiling);
+  // Beyond the classes' 6 cm: not ceiling yet, so the level merge leaves it apart.
+  CHECK(std::abs(planes[1].normal.dot(planes[2].centroid) + planes[1].offset) > 0.06);
+  CHECK(planes[2].label != PlaneClass::Ceiling);
+  labelCeilingPieces(planes);
+  CHECK(planes[2].label == PlaneClass::Ceiling);
+  CHECK(planes[3].label != PlaneClass::Ceiling);
+}

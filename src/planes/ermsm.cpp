@@ -227,6 +227,7 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   }
   classifyPlanes(patches.planes, {}, bottoms);
   mergeLevels(grid, patches, radians(config.kappa_deg), sheets ? config.noise : 0.0);
+  labelCeilingPieces(patches.planes);
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));  // the merged levels'
   stats.stages.merges += stage();
   detection.planes = std::move(patches.planes);

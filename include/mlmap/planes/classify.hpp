@@ -41,4 +41,12 @@ struct SurfaceSample {
 void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config = {},
                     std::span<const SurfaceSample> surface = {});
 
+// After the floor's and the ceiling's pieces are merged (detectPlanes): a level patch a
+// storey above the largest floor and within `riser_max` of the largest ceiling's plane
+// is ceiling too, not 'other' or 'step': a higher section, or the ceiling of the room
+// next door seen through a doorway, whose height the ceiling's plane gives only roughly
+// that far out. Only the label changes (such a piece is no part of the ceiling's plane, so
+// it is not merged into it). Hanging fixtures and ducts lie further below.
+void labelCeilingPieces(std::vector<Plane>& planes, const ClassifyConfig& config = {});
+
 }  // namespace mlmap
