@@ -72,7 +72,7 @@ TEST_CASE("Classes: a level patch with the map's surface under it is no floor (a
   CHECK(planes[0].label == PlaneClass::Floor);  // without samples, as before
 }
 
-TEST_CASE("Classes: a ceiling piece beyond a doorway, 9 cm off the ceiling's plane there, is ceiling; a fixture 40 cm below is not") {
+TEST_CASE("Classes: a ceiling piece beyond a doorway, 9 cm off the ceiling's plane there, is ceiling, a fixture 40 cm below is not") {
   // PCL's room_scan1: the next room's ceiling, seen through a door 4-5 m from the
   // ceiling's centroid, lies 9 cm below the ceiling's plane there (the two lean 1.2° apart
   // in a scan that is not quite flat); it was 'other'.
