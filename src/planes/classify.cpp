@@ -151,15 +151,12 @@ void labelCeilingPieces(std::vector<Plane>& planes, const ClassifyConfig& config
     if (plane.label == PlaneClass::Ceiling && (ceiling == nullptr || plane.area > ceiling->area)) ceiling = &plane;
   }
   if (floor == nullptr || ceiling == nullptr) return;
-  const Eigen::Vector3d floor_normal = floor->normal;
-  const double floor_offset = floor->offset;
-  const Eigen::Vector3d ceiling_normal = ceiling->normal;
-  const double ceiling_offset = ceiling->offset;
+  // Only the other patches' labels change below: the floor and the ceiling stay as they are.
   for (Plane& plane : planes) {
     if (plane.label == PlaneClass::Floor || plane.label == PlaneClass::Ceiling) continue;
     if (std::abs(plane.normal.z()) < cos_horizontal) continue;
-    if (floor_normal.dot(plane.centroid) + floor_offset >= config.ceiling_min_height &&
-        std::abs(ceiling_normal.dot(plane.centroid) + ceiling_offset) < config.riser_max) {
+    if (floor->normal.dot(plane.centroid) + floor->offset >= config.ceiling_min_height &&
+        std::abs(ceiling->normal.dot(plane.centroid) + ceiling->offset) < config.riser_max) {
       plane.label = PlaneClass::Ceiling;
     }
   }

@@ -84,7 +84,7 @@ class PatchFaces {
     index_.reserve(blocks_.size());
     for (std::size_t b = 0; b < blocks_.size(); ++b) {
       stats_[b] = grid.pointsOf(blocks_[b]);
-      centres_[b] = (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[blocks_[b]].cell), 0.0).finished() - origin;
+      centres_[b] = grid.pointsFrameOf(blocks_[b]) - origin;
       index_.emplace(blocks_[b], b);
     }
     patch_point_ = -(plane_.normal.dot(origin) + plane_.offset) * plane_.normal;

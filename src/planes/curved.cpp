@@ -70,8 +70,7 @@ Bend bendOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, con
   for (const std::uint32_t id : blocks) {
     const PointStats stats = grid.pointsOf(id);
     if (stats.empty()) return bend;  // a map without point moments
-    const Eigen::Vector2d cell_centre = grid.cellCentre(grid.blocks()[id].cell);
-    const Eigen::Vector3d mean = Eigen::Vector3d(cell_centre.x(), cell_centre.y(), 0.0) + stats.mean() - origin;
+    const Eigen::Vector3d mean = grid.pointsFrameOf(id) + stats.mean() - origin;
     Sample sample{across.dot(mean), normal.dot(mean), static_cast<double>(stats.count), stats.scatterMatrix()};
     const Eigen::Vector3d terms(1.0, sample.u, sample.u * sample.u);
     normal_matrix += sample.weight * terms * terms.transpose();

@@ -78,7 +78,7 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
 PointMoments patchMoments(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& origin) {
   PointMoments points;
   for (const std::uint32_t id : blocks) {
-    points.add(grid.pointsOf(id), (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[id].cell), 0.0).finished() - origin);
+    points.add(grid.pointsOf(id), grid.pointsFrameOf(id) - origin);
   }
   return points;
 }
@@ -159,9 +159,7 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
   // (at its root) once it has joined another.
   std::vector<std::optional<PointMoments>> moments(count);
   std::vector<std::optional<PointMoments>> group_moments(count);
-  const Eigen::Vector3d origin =
-      grid.size() > 0 ? (Eigen::Vector3d() << grid.cellCentre(grid.blocks().front().cell), 0.0).finished()
-                      : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d origin = grid.size() > 0 ? grid.pointsFrameOf(0) : Eigen::Vector3d::Zero();
   const auto momentsOf = [&](std::size_t k) -> const PointMoments& {
     if (!moments[k]) moments[k] = patchMoments(grid, set.blocks[k], origin);
     return *moments[k];

@@ -168,7 +168,7 @@ Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePl
   for (std::size_t k = 0; k < patch.blocks.size(); ++k) {
     const std::uint32_t id = patch.blocks[k];
     stats[k] = grid.pointsOf(id);
-    centres[k] = (Eigen::Vector3d() << grid.cellCentre(grid.blocks()[id].cell), 0.0).finished();
+    centres[k] = grid.pointsFrameOf(id);
     if (stats[k].empty()) continue;
     off[k] = std::abs(normal.dot(centres[k] + stats[k].mean() - point)) > cut;
     if (!off[k]) kept += stats[k].count;

@@ -80,6 +80,12 @@ class BlockGrid {
   // made from must still be alive.
   PointStats pointsOf(std::uint32_t id) const;
   Eigen::Vector2d cellCentre(CellIndex cell) const { return {(cell.j + 0.5) * cell_size_, (cell.i + 0.5) * cell_size_}; }
+  // The frame pointsOf(id) is in: block `id`'s cell centre at z 0 (its points' mean is
+  // this plus PointStats::mean()).
+  Eigen::Vector3d pointsFrameOf(std::uint32_t id) const {
+    const Eigen::Vector2d centre = cellCentre(blocks_[id].cell);
+    return {centre.x(), centre.y(), 0.0};
+  }
 
   // Calls visit(block_id) for every block in cells within Chebyshev radius `radius` of
   // `cell`, row by row and in each cell bottom to top: ids ascending.
