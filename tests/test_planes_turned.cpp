@@ -13,6 +13,7 @@
 #include "mlmap/sim/placement.hpp"
 #include "mlmap/sim/scene.hpp"
 #include "mlmap/sim/simulator.hpp"
+#include "simulated_map.hpp"
 
 using namespace mlmap;
 
@@ -47,11 +48,7 @@ struct WallFinding {
 std::vector<WallFinding> wallsOfTurnedRoom(double yaw_deg) {
   sim::Scene scene = sim::parseScene(kBoxRoomJson, "box_room.json");
   sim::transformScene(scene, sim::Placement{0.013, 0.021, yaw_deg});
-  MLMap map(0.05);
-  for (const sim::SimulatedScan& simulated : sim::simulate(scene)) {
-    const Scan& scan = simulated.scan;
-    for (std::size_t k = 0; k < scan.size(); ++k) map.insert(scan.worldPoint(k), scan.variance(k));
-  }
+  MLMap map = test::simulatedMap(scene, 0.05);
   const PlaneDetection detection = detectPlanes(map);
   std::vector<WallFinding> walls;
   for (const sim::GroundTruthPlane& truth : scene.ground_truth) {
