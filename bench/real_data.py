@@ -100,10 +100,12 @@ def write_inputs(scene, folder, up_option):
     return files, pose_file, options
 
 
-def score(labels, owner, points, planes, annotation):
-    """Per surface (share, n10, rms to the largest patch's plane, own rms, points) and the unmarked points.
+def score(labels, owner, points, planes, annotation, classes=None):
+    """Per surface (share, n10, rms to the largest patch's plane, own rms, points, that patch's
+    class) and the unmarked points.
 
-    labels: per point the patch id (<0 none); planes: id -> (normal, offset) in the frame of `points`.
+    labels: per point the patch id (<0 none); planes: id -> (normal, offset) in the frame of `points`;
+    classes: id -> class name (mlmap's planes JSON `label`), None for a method without classes.
     """
     rows = []
     for k, surface in enumerate(annotation["surfaces"]):
@@ -113,7 +115,7 @@ def score(labels, owner, points, planes, annotation):
         own = real_annotations.rms_to_plane(points[mine], normal, d)
         ids, counts = np.unique(labels[mine & (labels >= 0)], return_counts=True)
         if count == 0 or len(ids) == 0:
-            rows.append(dict(share=0.0, n10=0, joined=0, rms=float("nan"), own=own, points=count))
+            rows.append(dict(share=0.0, n10=0, joined=0, rms=float("nan"), own=own, points=count, cls=None))
             continue
         best = ids[np.argmax(counts)]
         n, off = planes[best]
@@ -121,7 +123,8 @@ def score(labels, owner, points, planes, annotation):
         joined = sum(1 for j in range(len(annotation["surfaces"])) if j != k and
                      np.sum((owner == j) & (labels == best)) >= 0.1 * max(np.sum(owner == j), 1))
         rows.append(dict(share=counts.max() / count, n10=int((counts >= 0.1 * count).sum()), joined=joined,
-                         rms=real_annotations.rms_to_plane(points[mine], n, off), own=own, points=count))
+                         rms=real_annotations.rms_to_plane(points[mine], n, off), own=own, points=count,
+                         cls=classes.get(best) if classes is not None else None))
     on_patch = labels >= 0
     unmarked = on_patch & (owner < 0)
     # A patch lies on no marked surface when most of its points are outside every one.
@@ -181,7 +184,8 @@ def run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features
     run(label + files)
     table = np.loadtxt(tag + ".labels.xyz", dtype=np.float64, ndmin=2)
     planes = {p["id"]: (np.array(p["normal"]), p["offset"]) for p in planes_json["planes"]}
-    return table[:, :3], table[:, 3].astype(int), planes, dict(build_s=build_s, detect_s=planes_json["timings"]["total_s"])
+    classes = {p["id"]: p.get("label") for p in planes_json["planes"]}
+    return table[:, :3], table[:, 3].astype(int), planes, classes, dict(build_s=build_s, detect_s=planes_json["timings"]["total_s"])
 
 
 def run_cgal(peers, folder, points):
@@ -236,13 +240,22 @@ def issue_counts(annotation, rows):
     """Issue 19's figures for one scene: walls, floor and ceiling found (>= 90 %), the other
     surfaces found (>= 70 %), each with how many are marked, and the surfaces whose points lie
     within 0.5 cm (RMS) of the largest patch's plane as of their own least-squares fit."""
-    counts = dict(structural_found=0, structural=0, other_found=0, other=0, rms_ok=0)
+    counts = dict(structural_found=0, structural=0, other_found=0, other=0, rms_ok=0, class_ok=0, classed=0)
     for surface, row in zip(annotation["surfaces"], rows):
         key = "structural" if is_structural(surface) else "other"
         counts[key] += 1
         counts[key + "_found"] += int(is_found(surface, row))
+        # The class a user reads off a found surface's patch, against the kind marked.
+        if is_found(surface, row) and row.get("cls") is not None and surface["kind"] in CLASS_OF_KIND:
+            counts["classed"] += 1
+            counts["class_ok"] += int(row["cls"] == CLASS_OF_KIND[surface["kind"]])
         counts["rms_ok"] += int(row["n10"] > 0 and not math.isnan(row["rms"]) and row["rms"] - row["own"] <= 0.005)
     return counts
+
+
+# mlmap's class (planes JSON `label`) for each marked kind: treads and risers are steps' parts.
+CLASS_OF_KIND = dict(floor="floor", ceiling="ceiling", wall="wall", table="table", tread="step", riser="step",
+                     step="step")
 
 
 def is_structural(surface):
@@ -275,6 +288,8 @@ def totals_table(totals):
                  f"{t['other_found']} of {t['other']}" for t in totals.values()) + " |",
              "| RMS to the patch's plane within 0.5 cm of the points' own fit | " + " | ".join(
                  f"{t['rms_ok']} of {t['marked']}" for t in totals.values()) + " |",
+             "| found surfaces whose patch's class is the kind marked (tread and riser: step) | " + " | ".join(
+                 f"{t['class_ok']} of {t['classed']}" if t["classed"] else "-" for t in totals.values()) + " |",
              "| patches on no marked surface | " + " | ".join(str(t["stray"]) for t in totals.values()) + " |",
              "| of those not flat (points' RMS to the patch > 2x the scan's marked surfaces' median) | " + " | ".join(
                  str(t["rough"]) for t in totals.values()) + " |",
@@ -415,11 +430,11 @@ def main():
         files, pose_file, up_options = scene_inputs(mlmap, scene, folder, features)
         results, labelled = {}, {}
         for cell in cells:
-            points, labels, planes, times = run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features,
+            points, labels, planes, classes, times = run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features,
                                                       a.planes_args.split())
             if len(labels) != len(world):
                 raise SystemExit(f"real_data: {name}: mlmap label wrote {len(labels)} points for {len(world)} input points")
-            rows, extra = score(labels, owner, points, planes, annotation)
+            rows, extra = score(labels, owner, points, planes, annotation, classes)
             results[f"mlmap {cell:g}"] = dict(rows=rows, extra=extra, times=times)
             labelled[f"mlmap {cell:g} m"] = labels
         if cgal:
@@ -431,7 +446,8 @@ def main():
         for method, result in results.items():
             found, marked = found_count(annotation, result["rows"])
             total = totals.setdefault(method, dict(found=0, marked=0, stray=0, rough=0, detect_s=0.0, structural_found=0,
-                                                   structural=0, other_found=0, other=0, rms_ok=0))
+                                                   structural=0, other_found=0, other=0, rms_ok=0, class_ok=0,
+                                                   classed=0))
             total["found"] += found
             total["marked"] += marked
             for key, count in issue_counts(annotation, result["rows"]).items():

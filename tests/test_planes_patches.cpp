@@ -439,4 +439,17 @@ TEST_CASE("outlineOfRuns: the corners of a rectangle, an L and two cells touchin
   // About a normal pointing down, counter-clockwise is the raster's own turn.
   CHECK(corners({{0, 0, 2}, {1, 0, 0}, {2, 0, 0}}, -level) == ell);
   CHECK(corners({}, wall).empty());
+  // Cells one empty cell apart are one patch (the split's gap of 2) and one outline: a
+  // wall whose raster columns alternate with empty ones (turned 41° to the grid, or seen
+  // in vertical scan lines) was outlined by one column, and one with a gap between its
+  // scan lines by one band. Notches and single cells a corner apart stay as they are.
+  const Corners wide{{0, 0}, {5, 0}, {5, 4}, {0, 4}};
+  CHECK(corners({{0, 0, 3}, {2, 0, 3}, {4, 0, 3}}, wall) == wide);
+  CHECK(corners({{0, 0, 0}, {0, 2, 3}, {1, 0, 0}, {1, 2, 3}, {2, 0, 0}, {2, 2, 3}, {3, 0, 0}, {3, 2, 3}, {4, 0, 0},
+                 {4, 2, 3}},
+                wall) == wide);
+  // Two cells two empty cells apart: two loops, the one with the lowest corner kept.
+  CHECK(corners({{0, 0, 0}, {3, 0, 0}}, wall) == Corners{{0, 0}, {1, 0}, {1, 1}, {0, 1}});
+  // Diagonally opposite across an empty cell: bridged, three cells touching at corners.
+  CHECK(corners({{0, 0, 0}, {2, 2, 2}}, wall).size() == 12);
 }
