@@ -94,3 +94,34 @@ TEST_CASE("Classes: a ceiling piece beyond a doorway, 9 cm off the ceiling's pla
   CHECK(planes[2].label == PlaneClass::Ceiling);
   CHECK(planes[3].label != PlaneClass::Ceiling);
 }
+
+TEST_CASE("Classes: steps climb from the floor riser by riser, a desk top a riser above a shelf stays a table") {
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  std::vector<Plane> planes;
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.0}, 0.0, 8.0, 0.0, 6.0));   // 0: floor
+  planes.push_back(levelPatch(up, {0.0, 0.0, 2.6}, 0.0, 8.0, 0.0, 6.0));   // 1: ceiling
+  // A flight of four treads 0.3 m deep and 0.17 m high along x from the floor.
+  for (int k = 1; k <= 4; ++k) {
+    planes.push_back(levelPatch(up, {0.0, 0.0, 0.17 * k}, 6.0 + 0.3 * (k - 1), 6.0 + 0.3 * k, 4.0, 5.0));  // 2-5
+  }
+  // A desk top at 0.74 m over a keyboard shelf at 0.60 m (PCL's room scans: desks a riser
+  // above such a piece were steps), and a chair seat at 0.46 m beside it.
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.74}, 1.0, 2.6, 0.5, 1.3));  // 6: desk
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.60}, 1.4, 2.0, 1.3, 1.6));  // 7: shelf
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.46}, 1.6, 2.1, 1.8, 2.3));  // 8: seat
+  classifyPlanes(planes);
+  CHECK(planes[0].label == PlaneClass::Floor);
+  CHECK(planes[1].label == PlaneClass::Ceiling);
+  for (int k = 2; k <= 5; ++k) CHECK(planes[k].label == PlaneClass::Step);
+  CHECK(planes[6].label == PlaneClass::Table);  // 'step' before
+  CHECK(planes[7].label == PlaneClass::Table);
+  CHECK(planes[8].label == PlaneClass::Table);
+
+  // Without a floor (the map's surface reaches below every patch) a riser-high
+  // neighbour still makes a step.
+  std::vector<Plane> floorless(planes.begin() + 2, planes.end());
+  const std::vector<SurfaceSample> below{{Eigen::Vector3d(3.0, 3.0, -1.0), 1000.0}};
+  classifyPlanes(floorless, {}, below);
+  for (int k = 0; k < 4; ++k) CHECK(floorless[k].label == PlaneClass::Step);
+  CHECK(floorless[4].label == PlaneClass::Step);
+}

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <cstdint>
+#include <vector>
 
 namespace mlmap {
 namespace {
@@ -86,30 +88,60 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   };
   // Horizontal patches first: risers and steps refer to them.
   for (const std::size_t k : horizontal) {
-    Plane& plane = planes[k];
-    const double z = plane.centroid.z();
-    if (near(floor, plane.centroid)) {
-      plane.label = PlaneClass::Floor;
-    } else if (near(ceiling, plane.centroid)) {
-      plane.label = PlaneClass::Ceiling;
+    if (near(floor, planes[k].centroid)) {
+      planes[k].label = PlaneClass::Floor;
+    } else if (near(ceiling, planes[k].centroid)) {
+      planes[k].label = PlaneClass::Ceiling;
     } else {
-      bool step = false;
-      for (const std::size_t other : horizontal) {
-        const double rise = std::abs(planes[other].centroid.z() - z);
-        if (other != k && rise >= config.riser_min && rise <= config.riser_max &&
-            neighbours(extents[k], extents[other], config.neighbour_gap)) {
-          step = true;
-        }
+      planes[k].label = PlaneClass::Other;
+    }
+  }
+  // Two level patches a riser apart, side by side: consecutive steps (or a step and the floor).
+  auto oneStepApart = [&](std::size_t a, std::size_t b) {
+    const double rise = std::abs(planes[a].centroid.z() - planes[b].centroid.z());
+    return a != b && rise >= config.riser_min && rise <= config.riser_max &&
+           neighbours(extents[a], extents[b], config.neighbour_gap);
+  };
+  auto belowCeiling = [&](const Plane& plane) {
+    return ceiling == nullptr || ceiling->normal.dot(plane.centroid) + ceiling->offset < -config.riser_max;
+  };
+  // With a floor in view, a step is one of a flight that climbs from it (or descends to
+  // it), riser by riser: a desk top beside a chair seat, a keyboard shelf or a drawer
+  // one riser below it is furniture, not a staircase. PCL's two room scans and Bobkov's
+  // room put four desk tops (0.7 m above the floor) and a sideboard top a riser from such
+  // a piece, and all were steps. Without a floor any riser-high neighbour makes a step.
+  std::vector<std::uint8_t> step(planes.size(), 0);
+  std::vector<std::size_t> flight;
+  for (const std::size_t k : horizontal) {
+    if (planes[k].label != PlaneClass::Other || !belowCeiling(planes[k])) continue;
+    for (const std::size_t other : horizontal) {
+      const bool linked = floor != nullptr ? planes[other].label == PlaneClass::Floor : other != k;
+      if (linked && oneStepApart(k, other)) {
+        step[k] = 1;
+        flight.push_back(k);
+        break;
       }
-      const double above_floor = floor != nullptr ? aboveFloor(plane.centroid) : 0.0;
-      const bool below_ceiling = ceiling == nullptr || ceiling->normal.dot(plane.centroid) + ceiling->offset < -config.riser_max;
-      if (step && below_ceiling) {
-        plane.label = PlaneClass::Step;
-      } else if (floor != nullptr && above_floor >= config.table_min_height && above_floor <= config.table_max_height) {
-        plane.label = PlaneClass::Table;
-      } else {
-        plane.label = PlaneClass::Other;
+    }
+  }
+  while (floor != nullptr && !flight.empty()) {
+    const std::size_t from = flight.back();
+    flight.pop_back();
+    for (const std::size_t k : horizontal) {
+      if (step[k] != 0 || planes[k].label != PlaneClass::Other || !belowCeiling(planes[k]) || !oneStepApart(k, from)) {
+        continue;
       }
+      step[k] = 1;
+      flight.push_back(k);
+    }
+  }
+  for (const std::size_t k : horizontal) {
+    Plane& plane = planes[k];
+    if (plane.label != PlaneClass::Other) continue;
+    const double above_floor = floor != nullptr ? aboveFloor(plane.centroid) : 0.0;
+    if (step[k] != 0) {
+      plane.label = PlaneClass::Step;
+    } else if (floor != nullptr && above_floor >= config.table_min_height && above_floor <= config.table_max_height) {
+      plane.label = PlaneClass::Table;
     }
   }
   for (std::size_t k = 0; k < planes.size(); ++k) {
