@@ -117,11 +117,16 @@ TEST_CASE("Classes: steps climb from the floor riser by riser, a desk top a rise
   CHECK(planes[7].label == PlaneClass::Table);
   CHECK(planes[8].label == PlaneClass::Table);
 
-  // Without a floor (the map's surface reaches below every patch) a riser-high
-  // neighbour still makes a step.
+  // Without a floor (the map's surface reaches below every patch) a flight of three or
+  // more is still steps; the desk, shelf and seat, two riser links, are too (a flight of
+  // three), but a desk with only a shelf a riser below it is not (Bobkov's room 2: its
+  // table and sideboard tops were steps).
   std::vector<Plane> floorless(planes.begin() + 2, planes.end());
   const std::vector<SurfaceSample> below{{Eigen::Vector3d(3.0, 3.0, -1.0), 1000.0}};
   classifyPlanes(floorless, {}, below);
   for (int k = 0; k < 4; ++k) CHECK(floorless[k].label == PlaneClass::Step);
-  CHECK(floorless[4].label == PlaneClass::Step);
+  std::vector<Plane> desk_and_shelf{planes[6], planes[7]};
+  classifyPlanes(desk_and_shelf, {}, below);
+  CHECK(desk_and_shelf[0].label == PlaneClass::Other);  // 'step' before
+  CHECK(desk_and_shelf[1].label == PlaneClass::Other);
 }

@@ -107,38 +107,54 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   };
   // With a floor in view, a step is one of a flight that climbs from it (or descends to
   // it), riser by riser: a desk top beside a chair seat, a keyboard shelf or a drawer
-  // one riser below it is furniture, not a staircase. PCL's two room scans and Bobkov's
-  // room put four desk tops (0.7 m above the floor) and a sideboard top a riser from such
-  // a piece, and all were steps. Without a floor any riser-high neighbour makes a step.
-  std::vector<std::uint8_t> step(planes.size(), 0);
-  std::vector<std::size_t> flight;
-  for (const std::size_t k : horizontal) {
-    if (planes[k].label != PlaneClass::Other || !belowCeiling(planes[k])) continue;
-    for (const std::size_t other : horizontal) {
-      const bool linked = floor != nullptr ? planes[other].label == PlaneClass::Floor : other != k;
-      if (linked && oneStepApart(k, other)) {
-        step[k] = 1;
-        flight.push_back(k);
-        break;
+  // one riser below it is furniture, not a staircase. PCL's two room scans put four desk
+  // tops (0.7 m above the floor) a riser from such a piece, and all were steps. Without a
+  // floor, a flight is three level patches or more, each a riser from the next: a table
+  // top and the one piece a riser below it are no staircase (Bobkov's room 2, a cloud cut
+  // above its floor: its table and sideboard tops were steps).
+  auto mayStep = [&](std::size_t k) { return planes[k].label == PlaneClass::Other && belowCeiling(planes[k]); };
+  std::vector<std::uint8_t> step(planes.size(), 0);  // 1: a step; 0 and 2: not
+  // Grows a flight from `members` (marked in `step` already) through riser links.
+  auto grow = [&](std::vector<std::size_t>& members) {
+    for (std::size_t n = 0; n < members.size(); ++n) {
+      for (const std::size_t k : horizontal) {
+        if (step[k] == 0 && mayStep(k) && oneStepApart(k, members[n])) {
+          step[k] = 1;
+          members.push_back(k);
+        }
       }
     }
-  }
-  while (floor != nullptr && !flight.empty()) {
-    const std::size_t from = flight.back();
-    flight.pop_back();
+  };
+  if (floor != nullptr) {
+    std::vector<std::size_t> flight;
     for (const std::size_t k : horizontal) {
-      if (step[k] != 0 || planes[k].label != PlaneClass::Other || !belowCeiling(planes[k]) || !oneStepApart(k, from)) {
-        continue;
+      if (!mayStep(k)) continue;
+      for (const std::size_t other : horizontal) {
+        if (planes[other].label == PlaneClass::Floor && oneStepApart(k, other)) {
+          step[k] = 1;
+          flight.push_back(k);
+          break;
+        }
       }
+    }
+    grow(flight);
+  } else {
+    for (const std::size_t k : horizontal) {
+      if (step[k] != 0 || !mayStep(k)) continue;
+      std::vector<std::size_t> flight{k};
       step[k] = 1;
-      flight.push_back(k);
+      grow(flight);
+      // Too short a flight: seen (2), so no later one grows into it, and no step.
+      if (flight.size() < 3) {
+        for (const std::size_t member : flight) step[member] = 2;
+      }
     }
   }
   for (const std::size_t k : horizontal) {
     Plane& plane = planes[k];
     if (plane.label != PlaneClass::Other) continue;
     const double above_floor = floor != nullptr ? aboveFloor(plane.centroid) : 0.0;
-    if (step[k] != 0) {
+    if (step[k] == 1) {
       plane.label = PlaneClass::Step;
     } else if (floor != nullptr && above_floor >= config.table_min_height && above_floor <= config.table_max_height) {
       plane.label = PlaneClass::Table;
