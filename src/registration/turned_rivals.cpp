@@ -8,15 +8,11 @@
 namespace mlmap::registration {
 namespace {
 
-// The horizontal extent is taken between these quantiles of the points' x and y: a few
-// readings through a doorway or a window would otherwise move the centre of a room.
-constexpr double kExtentQuantile = 0.02;
 // The screen of a turn looks at about this many of the source's points (the walls of them),
 // and lets ICP run where at least kScreenShare as many lie near the target turned as at the
-// result. Measured on the tuning split: furnished rooms 0.43-0.71 (at 0.5 a rival ran for most
-// room pairs, 20-30 ms each), the symmetric room 0.59-1.24 (probably the scans' 90 deg blind
-// sector: turned walls fall where the target saw nothing), the lab's and the corridors'
-// quarter turns 0.04-0.31.
+// result. The rivals that fit (from the start's place) had 0.82 (the held-out symmetric room
+// from 40 deg off) and 1.5 (tuning room-1, seed 7: the result's walls half off the map); the
+// furnished rooms' turns 0.3-0.64, the lab's and the corridors' quarter turns 0.04-0.31.
 constexpr std::size_t kScreenPoints = 1000;
 constexpr double kScreenShare = 0.6;
 // rad: a quarter turn and 10 deg for the scatter of ICP's answers.
@@ -24,32 +20,12 @@ constexpr double kMaxStartTurn = 100.0 * std::numbers::pi / 180.0;
 // A rival runs first on every kSampleStep-th source point, and on all of them only where that
 // sample explains at least rival_share of what the result explains of it.
 constexpr std::size_t kSampleStep = 8;
-// ... and at most this many iterations: from a turn of a room about its centre a rival that
-// fits converges in 5-8 (the tuning split's symmetric room), one that does not wanders on to
-// the limit of 60 (its furnished rooms: 40-60 iterations, 30-55 ms on a 1,000-2,000 point sample).
-constexpr int kSampleIterations = 12;
+// ... and at most this many iterations (a rival that wanders, in furnished rooms, ran to the
+// limit of 60: 30-55 ms on a sample of 1,000-2,000 points).
+constexpr int kSampleIterations = 20;
+// m, the sample's first gate: the start's place is up to max_start_translation (0.5 m) off.
+constexpr double kRivalGate = 1.0;
 constexpr double kLevelNormal = 0.7071;  // as verifyAlignment's kinds of surface
-
-double quantile(std::vector<double>& values, double q) {
-  const auto at = values.begin() + static_cast<long>(q * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), at, values.end());
-  return *at;
-}
-
-Eigen::Vector2d extentCentre(const std::vector<Point>& source, const Pose& pose) {
-  std::vector<double> xs;
-  std::vector<double> ys;
-  xs.reserve(source.size());
-  ys.reserve(source.size());
-  for (const Point& point : source) {
-    const Point moved = pose * point;
-    xs.push_back(moved.x());
-    ys.push_back(moved.y());
-  }
-  const double x = 0.5 * (quantile(xs, kExtentQuantile) + quantile(xs, 1.0 - kExtentQuantile));
-  const double y = 0.5 * (quantile(ys, kExtentQuantile) + quantile(ys, 1.0 - kExtentQuantile));
-  return {x, y};
-}
 
 // The source's wall points (normal within 45 deg of horizontal), every so many: a floor lies
 // on the target's floor at any turn, so only walls tell a turn apart.
@@ -75,24 +51,29 @@ std::vector<TurnedRival> turnedRivals(const std::vector<Point>& source, const st
                                       const IcpConfig& icp, double sigma, double gate, const BasinConfig& config) {
   std::vector<TurnedRival> rivals;
   if (source.empty()) return rivals;
-  const Eigen::Vector2d centre2 = extentCentre(source, pose);
-  const Eigen::Vector3d centre(centre2.x(), centre2.y(), 0.0);
   const std::vector<Point> walls = wallSample(source, normals);
   const double reach = icp.initial_max_distance;
   const double kept_near = static_cast<double>(nearCount(walls, target, pose, reach));
   std::vector<Point> sample;
   for (std::size_t k = 0; k < source.size(); k += kSampleStep) sample.push_back(source[k]);
+  const double kept_from_start = (pose.translation() - start.translation()).norm();
   const double kept_sample_share = verifyAlignment(sample, target, pose, sigma, gate, config).explained_share;
   IcpConfig sample_icp = icp;
   sample_icp.max_iterations = std::min(icp.max_iterations, kSampleIterations);
+  sample_icp.initial_max_distance = std::max(icp.initial_max_distance, kRivalGate);
+  sample_icp.max_fine_distance = std::min(icp.max_fine_distance, icp.initial_max_distance);
   for (const double turn_deg : {90.0, 180.0, 270.0}) {
-    // About the target's vertical: the floor stays level, only the heading and the place change.
-    Pose turn = Pose::Identity();
-    turn.linear() = Eigen::AngleAxisd(turn_deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    turn.translation() = centre - turn.linear() * centre;
+    // The result's heading turned about the target's vertical (the floor stays level) at the
+    // start's place: the start's place is a measurement (within max_start_translation of the
+    // truth), where a result turned a quarter off lies metres from it (165 cm in the tuning
+    // room-1; a turn about the centre of the scan's extent missed the truth there: placed so,
+    // the scan's walls outline no room).
     TurnedRival rival;
     rival.turn_deg = turn_deg;
-    rival.icp.pose = turn * pose;
+    rival.icp.pose.linear() =
+        Eigen::AngleAxisd(turn_deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+        pose.linear();
+    rival.icp.pose.translation() = start.translation();
     // A start is taken to be within a quarter turn of the truth (the far starts measured:
     // up to 90 deg); a rival further from it is none it could have meant. This leaves out the
     // half turn, which maps every rectangular room onto itself, unless the result itself is
@@ -113,9 +94,13 @@ std::vector<TurnedRival> turnedRivals(const std::vector<Point>& source, const st
     rival.icp = alignPoints(sample, target, rival.icp.pose, sample_icp);
     const Verification rough = verifyAlignment(sample, target, rival.icp.pose, sigma, gate, config);
     rival.ran = true;
-    if (rough.good && rough.explained_share >= config.rival_share * kept_sample_share) {
+    rival.nearer_start = kept_from_start - (rival.icp.pose.translation() - start.translation()).norm() >
+                         config.max_start_translation;
+    if (rough.good && (rough.explained_share >= config.rival_share * kept_sample_share || rival.nearer_start)) {
       rival.icp = alignPoints(source, target, rival.icp.pose, icp);
       rival.check = verifyAlignment(source, target, rival.icp.pose, sigma, gate, config);
+      rival.nearer_start = kept_from_start - (rival.icp.pose.translation() - start.translation()).norm() >
+                           config.max_start_translation;
     }
     rivals.push_back(std::move(rival));
   }
@@ -124,24 +109,26 @@ std::vector<TurnedRival> turnedRivals(const std::vector<Point>& source, const st
 
 RivalVerdict judgeRivals(const std::vector<TurnedRival>& rivals, const Verification& kept, const BasinConfig& config) {
   RivalVerdict verdict;
+  const auto contends = [&](const TurnedRival& rival, double share) {
+    return rival.check.good && (rival.check.explained_share >= config.rival_share * share || rival.nearer_start);
+  };
   for (const TurnedRival& rival : rivals) {
-    if (!rival.check.good) continue;
+    if (!contends(rival, kept.explained_share)) continue;
     if (verdict.best == nullptr || rival.check.explained_share > verdict.best->check.explained_share) {
       verdict.best = &rival;
     }
   }
   if (verdict.best == nullptr) return verdict;
   const double best_share = verdict.best->check.explained_share;
-  if (best_share < config.rival_share * kept.explained_share) return verdict;
   if (best_share < config.rival_replace * kept.explained_share) {
     verdict.ambiguous = true;  // too close to tell
     return verdict;
   }
-  // The kept result was itself the turned one: the rival is the better-explained answer, if
-  // no third comes close to it.
+  // The kept result was itself a turned one: the rival is the better-explained answer, if no
+  // third comes close to it.
   verdict.replaces = true;
   verdict.ambiguous = std::any_of(rivals.begin(), rivals.end(), [&](const TurnedRival& rival) {
-    return &rival != verdict.best && rival.check.good && rival.check.explained_share >= config.rival_share * best_share;
+    return &rival != verdict.best && contends(rival, best_share);
   });
   return verdict;
 }

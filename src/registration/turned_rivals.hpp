@@ -15,29 +15,33 @@
 namespace mlmap::registration {
 
 struct TurnedRival {
-  IcpResult icp;       // ICP from the result turned by turn_deg
+  IcpResult icp;       // ICP from the result's heading turned by turn_deg, at the start's place
   Verification check;  // verifyAlignment at icp.pose (no slide profile)
   double turn_deg = 0.0;
+  // Nearer the start's place than the result by more than max_start_translation: where the
+  // result lies beyond the start's bound and a turned answer within it explains the overlap,
+  // the result is no clearer than the rival, whatever their explained shares.
+  bool nearer_start = false;
   bool ran = false;    // ICP ran (on a sample at least); check is empty unless the sample made it a rival
 };
 
-// For each of 90, 180 and 270 deg: `pose` (source -> target) turned about the vertical
-// through the centre of the source's horizontal extent at `pose` (a room's centre where
-// the scan sees its walls: the turn maps the room onto itself as nearly as its shape
-// allows), one ICP run with `icp` from there, checked with (sigma, gate, config).
-// A turn is run only when the source's wall points (by `normals`, the source's own) lie
-// within icp.initial_max_distance of the target about as often turned as at `pose`.
-// Turns that leave the result more than a quarter turn (and 10 deg) from `start` are not run.
+// For each of 90, 180 and 270 deg: the result's heading turned so about the vertical, at the
+// start's place (`start`'s translation), one ICP run with `icp` (its first gate at least 1 m)
+// on a sample of the source, checked with (sigma, gate, config); on every point where the sample
+// makes it a rival (it explains rival_share of what the result explains of the sample, or lies
+// nearer the start). Turns not run: more than a quarter turn (and 10 deg) from `start`, or
+// where the source's wall points (by `normals`, the source's own) lie within
+// icp.initial_max_distance of the target much less often turned than at `pose`.
 std::vector<TurnedRival> turnedRivals(const std::vector<Point>& source, const std::vector<Eigen::Vector3d>& normals,
                                       const VoxelHashMap& target, const Pose& pose, const Pose& start,
                                       const IcpConfig& icp, double sigma, double gate, const BasinConfig& config);
 
-// What the rivals say of a result that verified with `kept`.
+// What the rivals say of a result that verified with `kept`. A rival contends when it explains
+// the overlap and either rival_share of kept's explained points or lies nearer the start.
 struct RivalVerdict {
-  const TurnedRival* best = nullptr;  // the best-explained rival that explains the overlap
-  bool replaces = false;   // best explains more than 1 / rival_share of kept's points ...
-  bool ambiguous = false;  // ... or at least rival_share of them, or (replacing) another rival
-                           // comes within rival_share of best
+  const TurnedRival* best = nullptr;  // the best-explained contending rival
+  bool replaces = false;   // best explains rival_replace times kept's points or more ...
+  bool ambiguous = false;  // ... or it does not, or (replacing) another rival contends with best
 };
 RivalVerdict judgeRivals(const std::vector<TurnedRival>& rivals, const Verification& kept, const BasinConfig& config);
 
