@@ -322,9 +322,10 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
       out.check = check;
     }
   }
-  // 3. A result that verifies, against its rivals a quarter, a half and three quarters of a
-  // turn away (turned_rivals.hpp): one that explains about as much makes it ambiguous, one
-  // that explains much more replaces it.
+  // 3. A result that verifies, against its rivals from the start's place a quarter, a half and
+  // three quarters of a turn away, and unturned where it lies beyond the start's bound
+  // (turned_rivals.hpp): one that explains about as much makes it ambiguous, one that explains
+  // much more replaces it.
   if (config.check_turns && verifiedCheck(out.check)) {
     const std::vector<TurnedRival> rivals =
         turnedRivals(source, surfaces.normals, target, out.icp.pose, start, icp, sigma, gate, config);
