@@ -56,8 +56,9 @@ TEST_CASE("alignVerified: far, turned starts in a symmetric room end at the trut
   const Pair pair = simulatedPair(kSymmetricRoomJson);
   // A single ICP run with a gate of 1 m stops on the wrong wall from these starts (measured:
   // decimetres and degrees off); the basin and the retries bring each back. The room turned
-  // by a quarter turn is the same room: where its rival is found (from -28 deg: it explains 66 %
-  // of the points, the truth 58 %) the result is ambiguous, not verified (test_verified_icp_turns.cpp).
+  // by a quarter turn is the same room, and a rival found there makes a result ambiguous, not
+  // verified (test_verified_icp_turns.cpp); from these starts the turned rivals lie farther from
+  // the start's place than the truth, or are not run, and each result is verified.
   const struct {
     Eigen::Vector3d shift;
     double yaw_deg;
