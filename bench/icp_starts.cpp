@@ -104,6 +104,9 @@ int runIcpStarts(int argc, char** argv) {
         run["eigenvalue_ratio"] = result.check.eigenvalue_ratio;
         run["unconstrained"] = result.unconstrained;
         run["no_overlap"] = result.no_overlap;
+        run["ambiguous"] = result.ambiguous;
+        run["rival_runs"] = result.rival_runs;
+        run["rival_share"] = result.rival_share;
         run["slides"] = result.slides;
         run["slide_fit"] = result.slide_fit;
         const SlideProfile& profile = result.check.profile;

@@ -30,6 +30,20 @@ constexpr int kMaxCoarseIterations = 20;
 constexpr double kCoarseSettledMotion = 0.05;
 constexpr double kCoarseKernelDivisor = 6.0;
 constexpr double kCoarseEigenvalueFactor = 2.0;
+// The coarse stage converges linearly: at the 0.5 m gate its steps shrink by 5-10 % an
+// iteration along a nearly constant direction (the lab from 8-10 deg off: 1-3 cm a step for
+// 20 iterations, ending at the iteration cap). Two successive steps within this angle of each
+// other (cos 0.9: 26 deg), the second shorter, are read as a geometric series, and its
+// remainder r/(1 - r) times the last step is taken at once (Aitken's extrapolation), moving
+// points at most this fraction of the gate: the matches that measured the step lie within the
+// gate. Stress benchmark, tune split (7 scenes, 84 starts), CPU time on one thread, large starts
+// 7.4 -> 5.6 s (lab -42 %, long corridor -28 %, room 3 -26 %, symmetric -20 %, rooms 1-2
+// -13-15 %, shipped corridor the same), small starts -20 % in the lab and the long corridor,
+// the same elsewhere; the same successes and median errors. Cosines 0.8-0.95 and fractions
+// 0.25-0.5 gave the same within 3 % (a first version, which also extrapolated 2-5 mm steps);
+// a fraction of 1.0 was 13 % slower, and extrapolating the fine stage's steps too saved nothing.
+constexpr double kExtrapolateCosine = 0.9;
+constexpr double kExtrapolateGateShare = 0.5;
 // Correspondences are kept, not searched again, after an iteration that moved points less
 // than this fraction of the smallest kernel scale (the range noise).
 constexpr double kReuseMotion = 0.2;
@@ -183,6 +197,27 @@ Vector6d solve(const LinearSystem& system, double radius, double min_ratio, doub
   return scaling.asDiagonal() * step;
 }
 
+// The coarse stage's extrapolation (see kExtrapolateCosine): after `step` (already applied to
+// result.pose), when it continues `previous` (scaled: rotations in metres at `radius`) and is
+// shorter, moves the pose on by the series' remainder; returns how far that moved points (m).
+// A jump starts the series anew: the next two steps decide the next one.
+double extrapolate(const Vector6d& step, double radius, double gate, Vector6d& previous, IcpResult& result) {
+  Vector6d scaled;
+  scaled << step.head<3>() * radius, step.tail<3>();
+  const double length = scaled.norm();
+  const double previous_length = previous.norm();
+  const double cosine_scaled = scaled.dot(previous);  // cos · |step| · |previous|
+  previous = scaled;
+  if (!(length > 0.0) || !(previous_length > length)) return 0.0;
+  if (cosine_scaled < kExtrapolateCosine * length * previous_length) return 0.0;
+  const double ratio = length / previous_length;
+  const double motion = step.tail<3>().norm() + step.head<3>().norm() * radius;
+  const double factor = std::min(ratio / (1.0 - ratio), kExtrapolateGateShare * gate / motion);
+  result.pose = applyIncrement(factor * step, result.pivot, result.pose);
+  previous.setZero();
+  return factor * motion;
+}
+
 }  // namespace
 
 Pose applyIncrement(const Vector6d& increment, const Eigen::Vector3d& pivot, const Pose& pose) {
@@ -230,6 +265,7 @@ IcpResult alignPoints(const std::vector<Point>& source, const VoxelHashMap& targ
   bool reuse = false;
   double moved_since_search = std::numeric_limits<double>::infinity();  // m, since the last Search::All
   LinearSystem system;
+  Vector6d previous_step = Vector6d::Zero();  // the coarse stage's last step, rotations in metres
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
     const long stride = coarse ? coarseStride(source.size()) : 1;
     // The kernel scale is a third of the gate: while the pose is still uncertain every
@@ -266,7 +302,11 @@ IcpResult alignPoints(const std::vector<Point>& source, const VoxelHashMap& targ
 
     const double step_translation = step.tail<3>().norm();
     const double step_rotation = step.head<3>().norm();
-    const double motion = step_translation + step_rotation * radius;
+    double motion = step_translation + step_rotation * radius;
+    // A step that settles the coarse stage ends it as it is.
+    if (coarse && motion >= kCoarseSettledMotion * config.min_max_distance) {
+      motion += extrapolate(step, radius, gate, previous_step, result);
+    }
     moved_since_search += motion;
     // The adaptive threshold: the gate follows the residual spread plus how far points
     // just moved, so it stays wide while the pose still travels and closes in once it

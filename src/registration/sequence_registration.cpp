@@ -135,6 +135,7 @@ RefinementResult SequenceRegistration::refine() {
   // The poses are already registered: a pair is checked, not searched for again.
   BasinConfig pair_basin = config_.basin;
   pair_basin.retry = false;
+  pair_basin.check_turns = false;  // each scan's pose was checked against its rivals when it was added
   pair_basin.max_start_translation = 0.0;
   pair_basin.max_start_yaw_deg = 0.0;
   // Each scan alone in its sensor frame: the targets of the pairwise ICP, with its noise.

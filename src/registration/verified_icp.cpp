@@ -1,6 +1,7 @@
 #include "mlmap/registration/verified_icp.hpp"
 
 #include "mlmap/registration/slide_profile.hpp"
+#include "turned_rivals.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -321,6 +322,26 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
       out.check = check;
     }
   }
+  // 3. A result that verifies, against its rivals from the start's place a quarter, a half and
+  // three quarters of a turn away, and unturned where it lies beyond the start's bound
+  // (turned_rivals.hpp): one that explains about as much makes it ambiguous, one that explains
+  // much more replaces it.
+  if (config.check_turns && verifiedCheck(out.check)) {
+    const std::vector<TurnedRival> rivals =
+        turnedRivals(source, surfaces.normals, target, out.icp.pose, start, icp, sigma, gate, config);
+    out.rival_runs =
+        static_cast<int>(std::count_if(rivals.begin(), rivals.end(), [](const TurnedRival& r) { return r.ran; }));
+    const RivalVerdict verdict = judgeRivals(rivals, out.check, config);
+    if (verdict.best != nullptr) {
+      out.rival_share = verdict.best->check.explained_share;
+      out.rival_turn_deg = verdict.best->turn_deg;
+    }
+    out.ambiguous = verdict.ambiguous;
+    if (verdict.replaces) {
+      out.icp = verdict.best->icp;
+      out.check = verify(out.icp.pose);
+    }
+  }
   // Along the weakest direction (a corridor's axis) ICP can stop centimetres short, verified
   // (the stress benchmark's held-out long corridor, 3 cm noise: `mlmap register` 5.4 cm off,
   // ICP's eigenvalue ratio 1.5e-2, not degenerate). Probably because the points facing the
@@ -330,7 +351,7 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
   // alone (fitSlide). Taken where they are a small minority of the matched points (below
   // kMaxFacingShare: where they are many, ICP weighs them well and their fit is no better),
   // measure a shift clearly (kFitSignificance standard errors) and the result still verifies.
-  if (verifiedCheck(out.check)) {
+  if (verifiedCheck(out.check) && !out.ambiguous) {
     const Eigen::Vector3d direction = out.check.profile.direction;
     const SlideFit fit = fitSlide(source, surfaces.normals, target, out.icp.pose, direction, bound, kMinFitPoints);
     const bool minority = static_cast<double>(fit.points) < kMaxFacingShare * static_cast<double>(out.check.matched);
@@ -345,7 +366,7 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
       }
     }
   }
-  out.verified = verifiedCheck(out.check);
+  out.verified = verifiedCheck(out.check) && !out.ambiguous;
   out.unconstrained = out.check.good && !out.check.constrained;
   char text[240];
   if (out.no_overlap) {
@@ -358,6 +379,11 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
                   "unconstrained: the result explains %.0f %% of the points but the geometry leaves a direction "
                   "free (eigenvalue ratio %.1e < %.1e)",
                   100.0 * out.check.explained_share, out.check.eigenvalue_ratio, config.min_eigenvalue_ratio);
+    out.reason = text;
+  } else if (out.ambiguous) {
+    std::snprintf(text, sizeof text,
+                  "ambiguous: the result turned by %.0f deg explains %.0f %% of the points, this one %.0f %%",
+                  out.rival_turn_deg, 100.0 * out.rival_share, 100.0 * out.check.explained_share);
     out.reason = text;
   } else if (!out.verified) {
     std::snprintf(text, sizeof text,

@@ -6,7 +6,9 @@
 // Two stages: a coarse one on an evenly spread ~1500-point subset of the source with the
 // gate held at its initial width until the pose stops moving (the wide searches are the
 // costly ones, and a wide gate is what brings a pose back from decimetres and degrees off),
-// then every point with the adaptive gate. Searches are skipped where their answer cannot
+// then every point with the adaptive gate. The coarse stage's steps converge linearly; two that
+// continue each other are extrapolated (the rest of their geometric series at once, within
+// half the gate). Searches are skipped where their answer cannot
 // have changed much: points that found nothing within the gate wait until the pose has moved
 // a quarter of the gate, and once an iteration moves points by less than 2 mm the
 // correspondences are kept and only re-linearised.

@@ -7,6 +7,9 @@
 // (the first gate set from the start's error bound and the cloud's radius), then other
 // starts (yaw and translation offsets about the given one); the best-explained result is
 // kept. A first run that matches almost nothing means the clouds do not overlap: no retry.
+// A result that verifies is compared with its rivals a quarter, a half and three quarters of
+// a turn away (run from the start's place): one that explains about as much makes it
+// ambiguous, not verified; one that explains much more replaces it.
 // A verified result whose weakest direction only a few points measure (a corridor's axis) is
 // moved along it to where those points fit (fitSlide), when they measure that clearly.
 #pragma once
@@ -66,6 +69,18 @@ struct BasinConfig {
   // far field's sparse sampling keeps it low even when right); maps 60 m apart 0 %.
   double min_matched_share = 0.02;
   bool retry = true;                    // false: one run, verified but not retried
+  // Rivals: a result that verifies is run again from the start's place with its heading
+  // turned by 90, 180 and 270 deg about the vertical, and unturned where it lies beyond
+  // max_start_translation from there (turned_rivals.hpp); a rival lying nearer the start's
+  // place by more than max_start_translation contends whatever it explains, one farther by as
+  // much does not. A rival that explains the overlap and at least
+  // rival_share of the result's explained points makes the result ambiguous (not verified);
+  // one that explains at least rival_replace times as many, within max_start_translation of
+  // the start's place, replaces it, verified when it verifies and no other rival comes within
+  // rival_share of it.
+  bool check_turns = true;
+  double rival_share = 0.8;
+  double rival_replace = 1.5;
 };
 
 // How well a pose explains the source against the target.
@@ -97,6 +112,10 @@ struct VerifiedIcp {
   bool verified = false;       // explains the overlap and the geometry constrains every direction
   bool unconstrained = false;  // explains the overlap but leaves a direction free (a corridor)
   bool no_overlap = false;     // the first run matched almost nothing: not retried
+  bool ambiguous = false;      // a turned rival explains about as much (BasinConfig::rival_share)
+  int rival_runs = 0;          // ICP runs from the turned rivals (not in attempts)
+  double rival_share = 0.0;    // the best-explained rival's explained share (0: none explains the overlap)
+  double rival_turn_deg = 0.0; // ... and its turn from the result it was run from
   std::string reason;          // why not verified; empty when verified
 };
 
