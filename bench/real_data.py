@@ -17,7 +17,8 @@ input point (`mlmap label`, input order). Per marked surface the table gives
   n10     the patches that hold >= 10 % of its points,
   joins   the other marked surfaces with >= 10 % of their points on that same patch,
   rms     the RMS of its points to that patch's plane (planes JSON) / to their own least-squares plane, cm;
-and per scene the points on patches outside every marked surface ("unmarked"); at the end, over
+and per scene the points on patches outside every marked surface ("unmarked") and the found surfaces
+whose patch's class (planes JSON `label`) is not the kind marked; at the end, over
 all scans, the surfaces found (and issue 19's split: walls, floor, ceiling >= 90 %, the others
 >= 70 %, RMS to the patch's plane within 0.5 cm of the points' own fit) and the patches on no
 marked surface per method. With --peers,
@@ -258,6 +259,17 @@ CLASS_OF_KIND = dict(floor="floor", ceiling="ceiling", wall="wall", table="table
                      step="step")
 
 
+def class_misses(annotation, results):
+    """Per method, the found surfaces whose patch's class is not the kind marked: 'NAME (method): class'."""
+    misses = []
+    for method, result in results.items():
+        for surface, row in zip(annotation["surfaces"], result["rows"]):
+            wanted = CLASS_OF_KIND.get(surface["kind"])
+            if is_found(surface, row) and row.get("cls") is not None and wanted and row["cls"] != wanted:
+                misses.append(f"{surface['name']} ({method}): {row['cls']}")
+    return misses
+
+
 def is_structural(surface):
     return surface["kind"] in ("floor", "ceiling", "wall")
 
@@ -443,6 +455,9 @@ def main():
             results["CGAL"] = dict(rows=rows, extra=extra, times=times)
             labelled["CGAL"] = labels
         text = table(scene, annotation, results)
+        wrong = class_misses(annotation, results)
+        if wrong:
+            text += "\n- found, but another class: " + "; ".join(wrong) + "\n"
         for method, result in results.items():
             found, marked = found_count(annotation, result["rows"])
             total = totals.setdefault(method, dict(found=0, marked=0, stray=0, rough=0, detect_s=0.0, structural_found=0,
