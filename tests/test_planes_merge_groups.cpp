@@ -81,8 +81,8 @@ TEST_CASE("Coplanar merge: two pieces of a long wall whose own fits lean apart a
     std::vector<std::uint32_t> near, far;
     for (std::uint32_t id = 0; id < grid.size(); ++id) (grid.blocks()[id].point.x() < 6.0 ? near : far).push_back(id);
     test::addPatch(grid, set, near, Eigen::Vector3f::UnitY(), kKappa, noise);
-    test::addPatch(grid, set, far, Eigen::Vector3f(static_cast<float>(-std::sin(bend)), static_cast<float>(std::cos(bend)), 0.0F),
-                   kKappa, noise);
+    const Eigen::Vector3f far_normal(static_cast<float>(-std::sin(bend)), static_cast<float>(std::cos(bend)), 0.0F);
+    test::addPatch(grid, set, far, far_normal, kKappa, noise);
     REQUIRE(set.planes.size() == 2);
     const Plane& first = set.planes[0];
     CHECK(std::abs(first.normal.dot(set.planes[1].centroid) + first.offset) > kEpsilon);

@@ -49,16 +49,19 @@ struct CellRaster {
   // The patch split joins cells a one-cell gap apart into one patch (gap_cells 2), so
   // its outline spans them too: an empty cell between two occupied ones (side by side,
   // one above the other, or diagonally opposite with none beside it) is filled; wider
-  // gaps, notches, inner corners and cells touching at a corner stay as they are. Without it a wall 41° to the grid (PCL's
-  // room_scan2: its raster columns alternate with empty ones where cells step along the
-  // wall) or one seen in vertical scan lines was outlined by its largest run of touching
-  // columns: 1.0 m² round a wall of 11.2 m², 0.55 m tall round one of 3 m, which then was
-  // no wall (classify.cpp reads heights from the outline). Every filled cell lies between
-  // two occupied ones, so the margin stays empty.
+  // gaps, notches, inner corners and cells touching at a corner stay as they are.
+  // Without it a wall 41° to the grid (PCL's room_scan2: its raster columns alternate
+  // with empty ones where cells step along the wall) or one seen in vertical scan lines
+  // was outlined by its largest run of touching columns: 1.0 m² round a wall of 11.2 m²,
+  // 0.55 m tall round one of 3 m, which then was no wall (classify.cpp reads heights from
+  // the outline). Every filled cell lies between two occupied ones, so the margin stays
+  // empty.
   void closeOneCellGaps() {
     const auto column = static_cast<std::ptrdiff_t>(rows);
     const std::vector<std::uint8_t> occupied = cells;
-    auto at = [&](std::size_t k, std::ptrdiff_t offset) { return occupied[static_cast<std::size_t>(static_cast<std::ptrdiff_t>(k) + offset)] == kOccupied; };
+    auto at = [&](std::size_t k, std::ptrdiff_t offset) {
+      return occupied[static_cast<std::size_t>(static_cast<std::ptrdiff_t>(k) + offset)] == kOccupied;
+    };
     // Inside the margin only: every neighbour of those cells lies in the raster.
     for (std::int64_t u = 1; u + 1 < columns; ++u) {
       for (std::int64_t v = 1; v + 1 < rows; ++v) {

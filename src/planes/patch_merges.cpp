@@ -123,9 +123,6 @@ struct CellBox {
   std::int32_t max_j = std::numeric_limits<std::int32_t>::min();
 };
 
-// Whether a block of `first` and one of `second` lie within `radius` cells of each other
-// (along both grid axes). Pairwise: a wall's pieces hold a few hundred cells each, and a
-// window a door wide would visit (2 radius + 1)² cells per block.
 // m: the median distance from the larger piece's plane of the smaller piece's blocks
 // that lie within `radius` cells of the larger one (infinity where none does). Pieces of
 // one long surface meet there though each piece's own fit leans: PCL's room_scan2 at 5 cm
@@ -139,13 +136,16 @@ double seamApart(const BlockGrid& grid, const PatchSet& set, std::size_t smaller
     grid.forEachNeighbour(grid.blocks()[id].cell, radius, [&](std::uint32_t other) {
       near = near || set.labels[other] == larger.id;
     });
-    if (near) {
-      distances.push_back(static_cast<float>(std::abs(larger.normal.dot(grid.blocks()[id].point.cast<double>()) + larger.offset)));
-    }
+    if (!near) continue;
+    const Eigen::Vector3d point = grid.blocks()[id].point.cast<double>();
+    distances.push_back(static_cast<float>(std::abs(larger.normal.dot(point) + larger.offset)));
   }
   return distances.empty() ? std::numeric_limits<double>::infinity() : medianOf(distances);
 }
 
+// Whether a block of `first` and one of `second` lie within `radius` cells of each other
+// (along both grid axes). Pairwise: a wall's pieces hold a few hundred cells each, and a
+// window a door wide would visit (2 radius + 1)² cells per block.
 bool withinCells(const BlockGrid& grid, const std::vector<std::uint32_t>& first, const std::vector<std::uint32_t>& second,
                  int radius) {
   for (const std::uint32_t a : first) {
