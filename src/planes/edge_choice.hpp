@@ -8,7 +8,10 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "mlmap/planes/point_labels.hpp"
@@ -26,6 +29,9 @@ constexpr std::size_t kMaxCandidates = 8;
 
 // Beams this close to grazing a plane rank as if at this cosine (about 87°).
 constexpr double kMinIncidenceCosine = 0.05;
+
+// |n_z| of a level patch: within the detector's θ (15°).
+constexpr double kLevelCosine = 0.966;
 
 // Planes closer in direction than this are layers of one surface (or parallel ones),
 // not two surfaces meeting at an edge: the detector's κ (25°).
@@ -54,6 +60,53 @@ struct HeightRange {  // m; empty (low > high) where unknown
 // seen in few places, but those are wide.
 std::vector<HeightRange> patchHeights(std::span<const Point> points, std::span<const std::uint32_t> sole,
                                       const std::vector<PointPlane>& fitted, double min_width);
+
+// How far each patch's outline reaches to either side of the refitted planes of the
+// patches round it: the least and the greatest signed distance of its vertices from the
+// other's plane, for every pair of patches whose outlines' boxes lie within `near`.
+class OutlineReach {
+ public:
+  OutlineReach(const std::vector<const std::vector<Eigen::Vector3d>*>& outline_of_slot,
+               const std::vector<PointPlane>& fitted, double near);
+  // [least, greatest] distance of patch a's outline from b's plane; nullopt for a pair
+  // farther apart than `near` (or without an outline).
+  std::optional<std::pair<double, double>> of(std::uint32_t a, std::uint32_t b) const;
+
+ private:
+  std::unordered_map<std::uint64_t, std::pair<float, float>> reach_;
+};
+
+// Past a surface's plane, seen from the scanner, lies only that surface's noise: a
+// point there (within `tail` times its tolerance along the beam, `along_tolerance`, or
+// across the plane where that is unknown) is not on a patch that ends at that plane
+// on the scanner's side (a box standing on the floor, a cabinet's side or a stair tread
+// against a wall) but the surface's own, however near the patch's plane it lies. The
+// surface's noise tail beyond its tolerance (3σ) put single wall and floor points on such
+// patches in the simulated lab and corridor at 10 cm: each of those patches then touched
+// a wall or the floor (issue 19's held-out measure). Returns the surface the point lies
+// behind (nearest in its tolerances), else `chosen`. Planes at an edge only (parallel
+// ones are layers), and surfaces larger than the patch; a patch whose outline reaches past
+// the plane by more than `slack` + the surface's tolerance does not end there (a wall
+// behind a table's top).
+// Only a surface the point's scanner sees from its front (`seen_from`, seenFrom) decides:
+// from behind, a crate's side says nothing of its top's edge. Without the scanner
+// (nullptr: a registered cloud) the surface's `seen_from` side stands for it, known for
+// level surfaces by their class (levelSeenFrom).
+std::uint32_t behindEdge(std::uint32_t chosen, const Point& point, const Point* scanner,
+                         std::span<const Candidate> candidates, const std::vector<PointPlane>& fitted,
+                         const std::vector<double>& along_tolerance, const std::vector<std::int8_t>& seen_from,
+                         const OutlineReach& reach, double slack, double tail);
+
+// Which side of its plane a level patch of a cloud without scanners was seen from:
+// above a floor, a table or a step (their open side), below a ceiling; else 0 (unknown:
+// a wall's room may lie on either side).
+std::int8_t levelSeenFrom(const Plane& plane, const PointPlane& fitted);
+
+// Which side of its plane each patch was seen from: the sign of n·s + offset for the
+// scanners s of most of its points (`slot_of_point`), 0 for none.
+std::vector<std::int8_t> seenFrom(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
+                                  const std::vector<PointPlane>& fitted,
+                                  const std::function<Point(std::size_t)>& scanner_of);
 
 // The candidate the point was measured on (0: none). Among layers (parallel planes) the
 // smallest rank. Where two surfaces meet at an edge, a point within both planes'

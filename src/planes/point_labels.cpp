@@ -26,7 +26,10 @@ namespace mlmap {
 // blocks of plane_seg's steps at 10 cm took each other's edges.
 constexpr std::int32_t kNear = 1;
 constexpr std::int32_t kNearLevel = 2;
-constexpr double kLevelNormal = 0.966;  // |n_z| of a level patch: within the detector's θ (15°)
+constexpr double kLevelNormal = kLevelCosine;
+// How far past a surface's tolerance (3σ) its noise tail is looked for (behindEdge): 6σ,
+// beyond which a normal tail holds one point in 500 million.
+constexpr double kTailTolerances = 2.0;
 
 // Whether the column of cell `at` holds a vertical block whose foot or top lies within
 // `reach` of height z: where a level surface's strip can hide in that block.
@@ -191,21 +194,37 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
                                     : alongTolerances(points, slot_of_point, fitted, beamOf, options.sigmas);
   // The patches each point lies on (within tolerance of their refitted planes), among its
   // collecting block's and those of the blocks round it that reach its height.
-  const auto gather = [&](std::size_t index, const Eigen::Vector3d& beam, std::array<Candidate, kMaxCandidates>& out) {
+  // `tail` (optional): the patches whose planes lie beyond their tolerance but within
+  // kTailTolerances of it, and `tail_found` their count.
+  const auto gather = [&](std::size_t index, const Eigen::Vector3d& beam, std::array<Candidate, kMaxCandidates>& out,
+                          std::array<Candidate, kMaxCandidates>* tail = nullptr, std::size_t* tail_found = nullptr) {
     const Point& p = points[index];
     std::size_t found = 0;
+    if (tail_found != nullptr) *tail_found = 0;
     if (!p.allFinite()) return found;
     const auto consider = [&](std::uint32_t slot) {
       const PointPlane& plane = fitted[slot];
       const double signed_distance = plane.normal.dot(p) + plane.offset;
-      if (std::abs(signed_distance) > plane.tolerance || found == kMaxCandidates) return;
-      for (std::size_t c = 0; c < found; ++c)
-        if (out[c].slot == slot) return;
       const double along = plane.normal.dot(beam);
-      const double rank = beam.isZero() ? std::abs(signed_distance) / plane.tolerance
-                                        : std::abs(signed_distance) / std::max(kMinIncidenceCosine, std::abs(along));
       // Where the beam meets the plane, from the measured point along it (m).
       const double meets = std::abs(along) >= kMinIncidenceCosine ? -signed_distance / along : 0.0;
+      if (std::abs(signed_distance) > plane.tolerance) {
+        // Across the plane a tail point lies no farther than along its beam.
+        const double tail_reach =
+            std::isfinite(along_tolerance[slot]) ? std::max(plane.tolerance, along_tolerance[slot]) : plane.tolerance;
+        if (tail == nullptr || *tail_found == kMaxCandidates ||
+            std::abs(signed_distance) > kTailTolerances * tail_reach)
+          return;
+        for (std::size_t c = 0; c < *tail_found; ++c)
+          if ((*tail)[c].slot == slot) return;
+        (*tail)[(*tail_found)++] = Candidate{slot, 0.0, meets};
+        return;
+      }
+      if (found == kMaxCandidates) return;
+      for (std::size_t c = 0; c < found; ++c)
+        if (out[c].slot == slot) return;
+      const double rank = beam.isZero() ? std::abs(signed_distance) / plane.tolerance
+                                        : std::abs(signed_distance) / std::max(kMinIncidenceCosine, std::abs(along));
       out[found++] = Candidate{slot, rank, meets};
     };
     if (slot_of_point[index] != 0) consider(slot_of_point[index]);
@@ -225,6 +244,23 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     }
     return found;
   };
+  // How far each patch's outline reaches past the planes round it (behindEdge).
+  std::vector<const std::vector<Eigen::Vector3d>*> outline_of_slot(slots, nullptr);
+  for (const Plane& plane : planes) {
+    const std::uint32_t slot = plane.id > 0 ? slotOf(plane.id) : 0;
+    if (slot != 0 && outline_of_slot[slot] == nullptr) outline_of_slot[slot] = &plane.outline;
+  }
+  const OutlineReach outline_reach(outline_of_slot, fitted, 2.0 * reach);
+  std::vector<std::int8_t> seen_from(slots, 0);
+  if (!beams.origin_of_point.empty()) {
+    seen_from = seenFrom(points, slot_of_point, fitted,
+                         [&](std::size_t index) { return beams.origins[beams.origin_of_point[index]]; });
+  } else {
+    for (const Plane& plane : planes) {
+      const std::uint32_t slot = plane.id > 0 ? slotOf(plane.id) : 0;
+      if (slot != 0) seen_from[slot] = levelSeenFrom(plane, fitted[slot]);
+    }
+  }
   // How high each patch reaches, from the points on it alone (patchHeights).
   std::vector<HeightRange> heights(slots);
   if (!beams.origin_of_point.empty()) {
@@ -267,8 +303,14 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     // grazing angle is far thinner than a wall seen head on), which holds for the plane's
     // typical beam but not for a point seen head on where the plane is mostly seen grazing.
     const Eigen::Vector3d beam = beamOf(index);
-    std::array<Candidate, kMaxCandidates> candidates;
-    std::size_t found = gather(index, beam, candidates);
+    std::array<Candidate, kMaxCandidates> candidates, tail;
+    std::size_t tail_found = 0;
+    std::size_t found = gather(index, beam, candidates, &tail, &tail_found);
+    // Every patch near the point, before the beam's range narrows them (behindEdge).
+    std::array<Candidate, 2 * kMaxCandidates> near;
+    std::copy_n(candidates.begin(), found, near.begin());
+    std::copy_n(tail.begin(), tail_found, near.begin() + static_cast<std::ptrdiff_t>(found));
+    const std::size_t near_found = found + tail_found;
     // Where several planes are near, one the beam meets further from the point than its
     // range noise reaches is not the one it measured (a pillar's facet, met at a grazing
     // angle in front of the floor). Alone it keeps the point: real range noise has longer
@@ -277,8 +319,12 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     if (found > 1 && std::any_of(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within))
       found = static_cast<std::size_t>(std::partition(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within) -
                                        candidates.begin());
-    const std::uint32_t chosen = likeliest(std::span(candidates.data(), found), fitted, beam,
-                                           [&](const Candidate& c) { return onPatch(points[index], beam, c); });
+    std::uint32_t chosen = likeliest(std::span(candidates.data(), found), fitted, beam,
+                                     [&](const Candidate& c) { return onPatch(points[index], beam, c); });
+    chosen = behindEdge(chosen, points[index],
+                        beams.origin_of_point.empty() ? nullptr : &beams.origins[beams.origin_of_point[index]],
+                        std::span(near.data(), near_found), fitted, along_tolerance, seen_from, outline_reach, reach,
+                        kTailTolerances);
     labels[index] = chosen != 0 ? fitted[chosen].id : labels[index] < 0 ? -1 : 0;
   }
   fitted.erase(fitted.begin());  // slot 0, "none"

@@ -46,11 +46,12 @@ struct BeamOrigins {
 // patches it lies on (within tolerance of the plane) among its block's and those of
 // the blocks of its own and the 8 neighbouring cells that reach its height, or none (0)
 // if it lies on none. Nearest: along the point's beam when `beams` are given (range
-// noise lies along the beam), else in units of each plane's tolerance. With beams, where
-// two surfaces meet at an edge the point takes the one its beam met first (a concave
-// edge: the floor at a cabinet's foot) or last (a convex one: a desk's top at its front),
-// each only where its patch is, and a plane the beam meets further off than that patch's
-// range noise reaches is no candidate beside one it meets within it.
+// noise lies along the beam), else in units of each plane's tolerance. Where two
+// surfaces meet at an edge a point on both goes to the larger patch; with beams, each
+// counts only where its patch is, a plane the beam meets further off than that patch's
+// range noise reaches is no candidate beside one it meets within it, and a point past a
+// surface's plane from its scanner, in that surface's noise tail, is the surface's, not
+// that of a patch ending at the plane on the scanner's side (a box on the floor).
 // `labels` are labelPoints' (any value ≤ 0 is "none"); `points` are world points.
 // Returns the refitted planes in id order (ids ≤ 0 and repeats left out). Deterministic
 // at any thread count.
