@@ -94,3 +94,30 @@ TEST_CASE("behindEdge: only a larger surface, seen from its front, that the patc
     CHECK(corner.choose(behind) == 2);
   }
 }
+
+TEST_CASE("nearerAlongBeam: a wall's point 3 sigma in front of it, seen along a cabinet's side, is the wall's") {
+  // The wall x = 0 (slot 1) and a cabinet's side y = 1 (slot 2), both with 3 cm of range
+  // noise along their beams (3 σ). A point 3.2 cm in front of the wall and 1.3 cm off the
+  // side's plane lies within the side's tolerance alone.
+  std::vector<PointPlane> fitted(3);
+  fitted[1] = PointPlane{1, Eigen::Vector3d::UnitX(), 0.0, 0.03, 100000};
+  fitted[2] = PointPlane{2, Eigen::Vector3d::UnitY(), -1.0, 0.03, 5000};
+  const std::vector<double> along{0.0, 0.03, 0.03};
+  const Point point{0.032, 0.987, 1.0};
+  const auto rank = [&](std::uint32_t slot, const Eigen::Vector3d& beam) {
+    return std::abs(fitted[slot].normal.dot(point) + fitted[slot].offset) /
+           std::max(kMinIncidenceCosine, std::abs(fitted[slot].normal.dot(beam)));
+  };
+  const auto choose = [&](const Eigen::Vector3d& beam) {
+    const Candidate alone{2, rank(2, beam), 0.0};
+    const std::vector<Candidate> tail{{1, rank(1, beam), 0.0}};
+    return nearerAlongBeam(alone, tail, fitted, along, 2.0);
+  };
+  // Seen nearly along the side: its plane lies 7 cm along the beam, the wall's 3.3 cm.
+  CHECK(choose(Eigen::Vector3d(-0.97, 0.18, 0.16).normalized()) == 1);
+  // Seen head on, the side's plane lies 1.3 cm along the beam: within its range noise.
+  CHECK(choose(Eigen::Vector3d(-0.3, 0.95, 0.0).normalized()) == 2);
+  // A smaller surface's tail takes nothing from a larger patch.
+  fitted[1].points = 1000;
+  CHECK(choose(Eigen::Vector3d(-0.97, 0.18, 0.16).normalized()) == 2);
+}

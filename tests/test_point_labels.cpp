@@ -296,7 +296,9 @@ TEST_CASE("Point labels: at the foot of a cabinet and above its side, the floor'
   MESSAGE(room << " points on the room's surfaces: " << taken << " on the furniture's patches, " << swapped
                << " on another of the room's");
   REQUIRE(room > 100000);
-  CHECK(taken * 10000 < room * 5);  // under 0.05 % (61 by distance alone, 42 by the beam's geometry, now 24)
+  // Under 0.01 %: 61 by distance alone, 42 by the beam's geometry, 24 with edge ties to
+  // the larger patch, now 10 (the surface's noise tail past its plane, behindEdge).
+  CHECK(taken * 10000 < room);
   // The strips where the room's own surfaces meet (a wall's foot) go to the larger one:
   // 515 points here, 78 when the beam's geometry decided and 309 by distance alone.
   CHECK(swapped * 200 < room);  // under 0.5 %

@@ -177,6 +177,27 @@ std::vector<std::int8_t> seenFrom(std::span<const Point> points, std::span<const
   return seen_from;
 }
 
+std::uint32_t nearerAlongBeam(const Candidate& alone, std::span<const Candidate> tail,
+                              const std::vector<PointPlane>& fitted, const std::vector<double>& along_tolerance,
+                              double limit) {
+  const PointPlane& patch = fitted[alone.slot];
+  double best = alone.rank / along_tolerance[alone.slot];
+  if (!(best > 1.0)) return alone.slot;  // within the patch's range noise (or unknown)
+  std::uint32_t chosen = alone.slot;
+  for (const Candidate& c : tail) {
+    const PointPlane& surface = fitted[c.slot];
+    if (std::abs(surface.normal.dot(patch.normal)) >= kEdgeCosine || surface.points <= patch.points ||
+        !std::isfinite(along_tolerance[c.slot]))
+      continue;
+    const double units = c.rank / along_tolerance[c.slot];
+    if (units < best && units <= limit) {
+      best = units;
+      chosen = c.slot;
+    }
+  }
+  return chosen;
+}
+
 std::int8_t levelSeenFrom(const Plane& plane, const PointPlane& fitted) {
   if (std::abs(fitted.normal.z()) < kLevelCosine) return 0;
   const std::int8_t up = fitted.normal.z() > 0.0 ? 1 : -1;

@@ -97,6 +97,19 @@ std::uint32_t behindEdge(std::uint32_t chosen, const Point& point, const Point* 
                          const std::vector<double>& along_tolerance, const std::vector<std::int8_t>& seen_from,
                          const OutlineReach& reach, double slack, double tail);
 
+// A point on one patch's plane alone (within its tolerance across it) whose beam meets
+// that plane farther off than the patch's range noise reaches (`along_tolerance`, from
+// `rank`: the distance along the beam, grazing beams as at kMinIncidenceCosine), while it
+// meets a larger surface's plane (`tail`: within `limit` of their tolerances across them)
+// nearer in that surface's range noise: the surface's noise tail, not the patch. At a
+// cabinet's side against a wall, the wall's points 3σ in front of it, seen along the
+// side, lie on the side's plane alone (the simulated lab, 5 cm: 6 of a cabinet's, 1-3 of
+// each crate's and cabinet's faces, then touching the wall or the floor). Returns the
+// surface, else `alone`'s slot.
+std::uint32_t nearerAlongBeam(const Candidate& alone, std::span<const Candidate> tail,
+                              const std::vector<PointPlane>& fitted, const std::vector<double>& along_tolerance,
+                              double limit);
+
 // Which side of its plane a level patch of a cloud without scanners was seen from:
 // above a floor, a table or a step (their open side), below a ceiling; else 0 (unknown:
 // a wall's room may lie on either side).

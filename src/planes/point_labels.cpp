@@ -208,6 +208,8 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
       const double along = plane.normal.dot(beam);
       // Where the beam meets the plane, from the measured point along it (m).
       const double meets = std::abs(along) >= kMinIncidenceCosine ? -signed_distance / along : 0.0;
+      const double rank = beam.isZero() ? std::abs(signed_distance) / plane.tolerance
+                                        : std::abs(signed_distance) / std::max(kMinIncidenceCosine, std::abs(along));
       if (std::abs(signed_distance) > plane.tolerance) {
         // Across the plane a tail point lies no farther than along its beam.
         const double tail_reach =
@@ -217,14 +219,12 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
           return;
         for (std::size_t c = 0; c < *tail_found; ++c)
           if ((*tail)[c].slot == slot) return;
-        (*tail)[(*tail_found)++] = Candidate{slot, 0.0, meets};
+        (*tail)[(*tail_found)++] = Candidate{slot, rank, meets};
         return;
       }
       if (found == kMaxCandidates) return;
       for (std::size_t c = 0; c < found; ++c)
         if (out[c].slot == slot) return;
-      const double rank = beam.isZero() ? std::abs(signed_distance) / plane.tolerance
-                                        : std::abs(signed_distance) / std::max(kMinIncidenceCosine, std::abs(along));
       out[found++] = Candidate{slot, rank, meets};
     };
     if (slot_of_point[index] != 0) consider(slot_of_point[index]);
@@ -321,6 +321,9 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
                                        candidates.begin());
     std::uint32_t chosen = likeliest(std::span(candidates.data(), found), fitted, beam,
                                      [&](const Candidate& c) { return onPatch(points[index], beam, c); });
+    if (!beam.isZero() && found == 1)
+      chosen = nearerAlongBeam(candidates[0], std::span(tail.data(), tail_found), fitted, along_tolerance,
+                               kTailTolerances);
     chosen = behindEdge(chosen, points[index],
                         beams.origin_of_point.empty() ? nullptr : &beams.origins[beams.origin_of_point[index]],
                         std::span(near.data(), near_found), fitted, along_tolerance, seen_from, outline_reach, reach,
