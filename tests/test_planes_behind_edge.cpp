@@ -121,3 +121,14 @@ TEST_CASE("nearerAlongBeam: a wall's point 3 sigma in front of it, seen along a 
   fitted[1].points = 1000;
   CHECK(choose(Eigen::Vector3d(-0.97, 0.18, 0.16).normalized()) == 2);
 }
+
+TEST_CASE("withinRangeNoise: a plane the beam grazes is not within its range noise however near") {
+  const std::vector<double> along{0.0, 0.03, 0.06};
+  // The floor, 3.5 cm off along the beam: beyond its 3 cm.
+  CHECK_FALSE(withinRangeNoise(Candidate{1, 0.035, 0.035}, along));
+  CHECK(withinRangeNoise(Candidate{1, 0.02, 0.02}, along));
+  // A face the beam grazes (|n·beam| < kMinIncidenceCosine): 2.5 cm across it is at least
+  // 0.5 m along the beam, whatever `meets` (0 there) says.
+  const double across = 0.025;
+  CHECK_FALSE(withinRangeNoise(Candidate{2, across / kMinIncidenceCosine, 0.0}, along));
+}

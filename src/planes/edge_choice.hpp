@@ -110,6 +110,15 @@ std::uint32_t nearerAlongBeam(const Candidate& alone, std::span<const Candidate>
                               const std::vector<PointPlane>& fitted, const std::vector<double>& along_tolerance,
                               double limit);
 
+// Whether the beam meets the candidate's plane within that patch's range noise
+// (`along_tolerance`). By its rank, not `meets`: a grazing beam (under kMinIncidenceCosine)
+// meets the plane at least |distance| / kMinIncidenceCosine off, where `meets` says 0 (the
+// simulated lab at 10 cm: a floor point 0.8 cm above the floor went to a patch its beam
+// grazed, the floor, 3.5 cm off along the beam, left out as beyond its 3 cm).
+inline bool withinRangeNoise(const Candidate& c, const std::vector<double>& along_tolerance) {
+  return c.rank <= along_tolerance[c.slot];
+}
+
 // Which side of its plane a level patch of a cloud without scanners was seen from:
 // above a floor, a table or a step (their open side), below a ceiling; else 0 (unknown:
 // a wall's room may lie on either side).

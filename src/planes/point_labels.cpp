@@ -315,7 +315,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     // range noise reaches is not the one it measured (a pillar's facet, met at a grazing
     // angle in front of the floor). Alone it keeps the point: real range noise has longer
     // tails than the estimate (3-9 % of the floors of PCL's room scans lie beyond it).
-    const auto within = [&](const Candidate& c) { return std::abs(c.meets) <= along_tolerance[c.slot]; };
+    const auto within = [&](const Candidate& c) { return withinRangeNoise(c, along_tolerance); };
     if (found > 1 && std::any_of(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within))
       found = static_cast<std::size_t>(std::partition(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within) -
                                        candidates.begin());
