@@ -130,3 +130,34 @@ TEST_CASE("Classes: steps climb from the floor riser by riser, a desk top a rise
   CHECK(desk_and_shelf[0].label == PlaneClass::Other);  // 'step' before
   CHECK(desk_and_shelf[1].label == PlaneClass::Other);
 }
+
+TEST_CASE("Classes: a table over the chairs' seats, a riser above them, and a sideboard beside it are no flight") {
+  // Bobkov's room 2 at 10 cm, cut above its floor: the table top (z 2.15), the seats'
+  // patch partly under it (1.90: 0.25 below, one riser) and the sideboard's top beside it
+  // (1.97) were a flight of three, all 'step'. Treads lie side by side, not one over the other.
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  std::vector<Plane> planes;
+  planes.push_back(levelPatch(up, {0.0, 0.0, 2.15}, 0.5, 3.5, 0.6, 2.7));    // table top
+  planes.push_back(levelPatch(up, {0.0, 0.0, 1.90}, 0.3, 2.3, 1.6, 3.2));    // seats, half under it
+  planes.push_back(levelPatch(up, {0.0, 0.0, 1.97}, -1.7, 0.1, -0.2, 0.9));  // sideboard
+  const std::vector<SurfaceSample> below{{Eigen::Vector3d(1.0, 1.0, 0.5), 1000.0}};
+  classifyPlanes(planes, {}, below);
+  for (const Plane& plane : planes) CHECK(plane.label == PlaneClass::Other);  // 'step' before
+
+  // Treads of a flight turned 45° to the grid still are one: their outlines' boxes
+  // overlap, the outlines themselves only in a strip along each riser.
+  std::vector<Plane> flight;
+  const double c = std::sqrt(0.5);
+  for (int k = 0; k < 4; ++k) {
+    Plane tread = levelPatch(up, {0.0, 0.0, 0.17 * (k + 1)}, 0.0, 0.0, 0.0, 0.0);
+    const auto at = [&](double u, double v) { return Eigen::Vector3d(c * (u - v), c * (u + v), 0.17 * (k + 1)); };
+    const double u0 = 0.3 * k - 0.05, u1 = 0.3 * (k + 1) + 0.05;  // outlines rounded out by half a 10 cm cell
+    tread.outline = {at(u0, 0.0), at(u1, 0.0), at(u1, 1.0), at(u0, 1.0)};
+    tread.centroid = at(0.5 * (u0 + u1), 0.5);
+    tread.area = 0.3;
+    flight.push_back(tread);
+  }
+  const std::vector<SurfaceSample> under_flight{{Eigen::Vector3d(0.0, 0.5, -1.0), 1000.0}};
+  classifyPlanes(flight, {}, under_flight);
+  for (const Plane& tread : flight) CHECK(tread.label == PlaneClass::Step);
+}

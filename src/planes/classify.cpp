@@ -1,5 +1,6 @@
 #include "mlmap/planes/classify.hpp"
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -23,6 +24,48 @@ Extent extentOf(const Plane& plane) {
   }
   if (plane.outline.empty()) extent.min = extent.max = plane.centroid;
   return extent;
+}
+
+// Whether (x, y) lies inside the outline seen from above (even-odd rule), and how far
+// from its boundary.
+bool insideOutline(const std::vector<Eigen::Vector3d>& outline, double x, double y, double& depth) {
+  bool inside = false;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0, previous = outline.size() - 1; k < outline.size(); previous = k++) {
+    const Eigen::Vector2d a = outline[k].head<2>(), b = outline[previous].head<2>(), p(x, y);
+    if ((a.y() > y) != (b.y() > y) && x < a.x() + (y - a.y()) * (b.x() - a.x()) / (b.y() - a.y())) inside = !inside;
+    const Eigen::Vector2d edge = b - a;
+    const double t = edge.squaredNorm() > 0.0 ? std::clamp((p - a).dot(edge) / edge.squaredNorm(), 0.0, 1.0) : 0.0;
+    nearest = std::min(nearest, (p - a - t * edge).norm());
+  }
+  depth = nearest;
+  return inside;
+}
+
+// The share of the smaller of two patches that lies over (or under) the other deeper
+// than `depth` inside both outlines seen from above, sampled on a grid of at most
+// kOverlapSamples points.
+constexpr double kOverlapSamples = 20000.0;
+double deepOverlapShare(const Plane& a, const Plane& b, const Extent& extent_a, const Extent& extent_b,
+                        double depth) {
+  if (a.outline.size() < 3 || b.outline.size() < 3) return 0.0;
+  const double x0 = std::max(extent_a.min.x(), extent_b.min.x()) + depth;
+  const double x1 = std::min(extent_a.max.x(), extent_b.max.x()) - depth;
+  const double y0 = std::max(extent_a.min.y(), extent_b.min.y()) + depth;
+  const double y1 = std::min(extent_a.max.y(), extent_b.max.y()) - depth;
+  const double smaller = std::min(a.area, b.area);
+  if (!(x1 > x0 && y1 > y0 && smaller > 0.0)) return 0.0;
+  const double step = std::max(0.01, std::sqrt((x1 - x0) * (y1 - y0) / kOverlapSamples));
+  std::size_t both = 0;
+  for (double x = x0 + 0.5 * step; x < x1; x += step) {
+    for (double y = y0 + 0.5 * step; y < y1; y += step) {
+      double depth_a = 0.0, depth_b = 0.0;
+      if (insideOutline(a.outline, x, y, depth_a) && depth_a >= depth && insideOutline(b.outline, x, y, depth_b) &&
+          depth_b >= depth)
+        ++both;
+    }
+  }
+  return static_cast<double>(both) * step * step / smaller;
 }
 
 bool neighbours(const Extent& a, const Extent& b, double gap) {
@@ -96,11 +139,18 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
       planes[k].label = PlaneClass::Other;
     }
   }
-  // Two level patches a riser apart, side by side: consecutive steps (or a step and the floor).
+  // Two level patches a riser apart, side by side: consecutive steps (or a step and the
+  // floor). Side by side, not one over the other: a tread's outline overlaps the next one's
+  // in a strip along the riser, as wide as the outlines round out to cells; a chair's seat
+  // lies under the table (Bobkov's room 2 at 10 cm: the seats' patch under the table top,
+  // a riser below it, made the table, the seats and the sideboard a flight of steps).
   auto oneStepApart = [&](std::size_t a, std::size_t b) {
     const double rise = std::abs(planes[a].centroid.z() - planes[b].centroid.z());
     return a != b && rise >= config.riser_min && rise <= config.riser_max &&
-           neighbours(extents[a], extents[b], config.neighbour_gap);
+           neighbours(extents[a], extents[b], config.neighbour_gap) &&
+           (planes[a].label == PlaneClass::Floor || planes[b].label == PlaneClass::Floor ||
+            deepOverlapShare(planes[a], planes[b], extents[a], extents[b], config.step_overlap_depth) <=
+                config.max_step_overlap);
   };
   auto belowCeiling = [&](const Plane& plane) {
     return ceiling == nullptr || ceiling->normal.dot(plane.centroid) + ceiling->offset < -config.riser_max;

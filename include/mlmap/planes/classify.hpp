@@ -17,6 +17,12 @@ struct ClassifyConfig {
   double riser_min = 0.08;          // m, height difference between neighbouring steps
   double riser_max = 0.25;          // m
   double neighbour_gap = 0.4;       // m, horizontal gap between outlines that still neighbour
+  // Consecutive steps lie side by side: of the smaller, at most `max_step_overlap` lies
+  // deeper than `step_overlap_depth` inside both outlines seen from above. Treads' outlines
+  // overlap only along the riser, as far as they round out to cells (half a 10 cm cell
+  // each, 0.1 m); a seat under a table lies well inside it.
+  double step_overlap_depth = 0.1;  // m
+  double max_step_overlap = 0.1;
   double wall_min_height = 1.0;     // m, vertical extent of a wall
   double floor_search = 0.5;        // m: the floor is the largest patch this close to the lowest
   double ceiling_min_height = 1.8;  // m above the floor
