@@ -145,8 +145,7 @@ std::uint32_t behindEdge(std::uint32_t chosen, const Point& point, const Point* 
     // Past the plane from the scanner, within the surface's noise tail: along the beam
     // (range noise lies along it) where the surface's range noise is known.
     const bool along_known = std::isfinite(along_tolerance[c.slot]);
-    const double units =
-        along_known ? std::abs(c.meets) / along_tolerance[c.slot] : std::abs(distance) / surface.tolerance;
+    const double units = along_known ? c.rank / along_tolerance[c.slot] : std::abs(distance) / surface.tolerance;
     if (scanner_side * distance >= 0.0 || units > tail) continue;
     const auto extent = reach.of(chosen, c.slot);
     if (!extent) continue;
