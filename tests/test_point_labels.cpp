@@ -108,6 +108,26 @@ std::string boxRoomScene(const std::string& poses, const std::string& furniture)
     ]})";
 }
 
+// A cabinet against a wall and a crate on the floor, scanned from three poses with 1 cm
+// of range noise: simulated and detected once for the tests that use it.
+const Scanned& cabinetRoom() {
+  static const Scanned scanned(
+      boxRoomScene(R"({"x": 2.5, "y": 2.0, "yaw_deg": 150}, {"x": 3.5, "y": 3.2, "yaw_deg": 200},
+                      {"x": 2.0, "y": 3.5, "yaw_deg": -90})",
+                   R"({"type": "box", "class": "other", "min": [0, 1.0, 0], "max": [0.5, 3.0, 1.8], "omit": ["bottom", "x-"]},
+      {"type": "box", "class": "other", "min": [4.0, 1.0, 0], "max": [4.6, 1.5, 0.5], "omit": ["bottom"]})"),
+      "cabinet.json");
+  return scanned;
+}
+
+// Each patch's surface: the true plane most of its points lie on.
+std::map<std::int32_t, std::int32_t> surfaceOfPatches(const std::vector<std::int32_t>& labels,
+                                                      const std::vector<std::int32_t>& truth) {
+  std::map<std::int32_t, std::int32_t> surface_of;
+  for (const auto& [patch, by_truth] : test::truthByPatch(labels, truth)) surface_of[patch] = test::majorityTruth(by_truth);
+  return surface_of;
+}
+
 }  // namespace
 
 TEST_CASE("Point labels: floor points in the wall's corner blocks leave the wall for the floor") {
@@ -272,19 +292,12 @@ TEST_CASE("Point labels: at the foot of a cabinet and above its side, the floor'
   // of range noise. Points where they meet the floor or the wall lie within noise of both
   // planes and go to the larger patch; a plane is only where its patch is (above the
   // cabinet its side's plane is air).
-  const Scanned scanned(
-      boxRoomScene(R"({"x": 2.5, "y": 2.0, "yaw_deg": 150}, {"x": 3.5, "y": 3.2, "yaw_deg": 200},
-                      {"x": 2.0, "y": 3.5, "yaw_deg": -90})",
-                   R"({"type": "box", "class": "other", "min": [0, 1.0, 0], "max": [0.5, 3.0, 1.8], "omit": ["bottom", "x-"]},
-      {"type": "box", "class": "other", "min": [4.0, 1.0, 0], "max": [4.6, 1.5, 0.5], "omit": ["bottom"]})"),
-      "cabinet.json");
+  const Scanned& scanned = cabinetRoom();
   const std::vector<Point>& points = scanned.points;
   const std::vector<std::int32_t>& truth = scanned.truth;
   std::vector<std::int32_t> labels = scanned.blockLabels();
   refinePointLabels(scanned.map, scanned.detection.planes, points, labels, scanned.options(), scanned.beams());
-  // Each patch's surface: the true plane most of its points lie on.
-  std::map<std::int32_t, std::int32_t> surface_of;
-  for (const auto& [patch, by_truth] : test::truthByPatch(labels, truth)) surface_of[patch] = test::majorityTruth(by_truth);
+  std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, truth);
   // The room's own surfaces are planes 0-5; their points on a patch of the furniture's.
   std::size_t room = 0, taken = 0, swapped = 0;
   for (std::size_t k = 0; k < points.size(); ++k) {
@@ -381,17 +394,10 @@ TEST_CASE("Point labels: a room surface's points past its plane from the scanner
   // patch alone and went to it, which then touched the wall or the floor (issue 19's
   // held-out measure: the simulated lab at 10 cm, 2 of its 11 false patches). Nothing
   // but the surface itself lies past it: the furniture's patches end there.
-  const Scanned scanned(
-      boxRoomScene(R"({"x": 2.5, "y": 2.0, "yaw_deg": 150}, {"x": 3.5, "y": 3.2, "yaw_deg": 200},
-                      {"x": 2.0, "y": 3.5, "yaw_deg": -90})",
-                   R"({"type": "box", "class": "other", "min": [0, 1.0, 0], "max": [0.5, 3.0, 1.8], "omit": ["bottom", "x-"]},
-      {"type": "box", "class": "other", "min": [4.0, 1.0, 0], "max": [4.6, 1.5, 0.5], "omit": ["bottom"]})"),
-      "cabinet.json");
+  const Scanned& scanned = cabinetRoom();
   std::vector<std::int32_t> labels = scanned.blockLabels();
   refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, scanned.options(), scanned.beams());
-  std::map<std::int32_t, std::int32_t> surface_of;
-  for (const auto& [patch, by_truth] : test::truthByPatch(labels, scanned.truth))
-    surface_of[patch] = test::majorityTruth(by_truth);
+  std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, scanned.truth);
   // The room's surfaces (true planes 0-5) are axis-aligned: floor z = 0, ceiling z = 2.8,
   // walls x = 0 and 6, y = 0 and 5.
   const auto pastOwnPlane = [&](std::size_t k) {

@@ -15,7 +15,7 @@
 namespace mlmap {
 
 // How many cells round a point its candidate patches' blocks are looked for: one, and two
-// for level patches. Where a wall or a cabinet stands on the floor, the column holding its
+// for level patches (kLevelCosine). Where a wall or a cabinet stands on the floor, the column holding its
 // foot holds the floor's strip there too, in the vertical block (section IV joins them),
 // and a face on a cell boundary fills both columns beside it: the floor's nearest own
 // block can lie two cells from a floor point at the foot, and that point went to the face
@@ -26,7 +26,6 @@ namespace mlmap {
 // blocks of plane_seg's steps at 10 cm took each other's edges.
 constexpr std::int32_t kNear = 1;
 constexpr std::int32_t kNearLevel = 2;
-constexpr double kLevelNormal = kLevelCosine;
 // How far past a surface's tolerance (3σ) its noise tail is looked for (behindEdge): 6σ,
 // beyond which a normal tail holds one point in 500 million.
 constexpr double kTailTolerances = 2.0;
@@ -145,12 +144,12 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   };
   const std::size_t slots = ids.size() + 1;
   std::vector<PointPlane> fitted(slots);
-  std::vector<bool> described(slots, false);
+  std::vector<const Plane*> plane_of_slot(slots, nullptr);  // the first plane of each id
   std::vector<Eigen::Vector3d> origin(slots, Eigen::Vector3d::Zero());
   for (const Plane& plane : planes) {
     const std::uint32_t slot = plane.id > 0 ? slotOf(plane.id) : 0;
-    if (slot == 0 || described[slot]) continue;
-    described[slot] = true;
+    if (slot == 0 || plane_of_slot[slot] != nullptr) continue;
+    plane_of_slot[slot] = &plane;
     origin[slot] = plane.centroid.allFinite() ? plane.centroid : Eigen::Vector3d::Zero();
     fitted[slot].id = plane.id;
     fitted[slot].normal = plane.normal.allFinite() && plane.normal.norm() > 0.0 ? plane.normal.normalized()
@@ -237,7 +236,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
           for (const Block& block : map.blocks(CellIndex{cell->i + di, cell->j + dj})) {
             if (block.plane <= 0 || p.z() > block.height + reach || p.z() < block.bottom() - reach) continue;
             const std::uint32_t slot = slotOf(block.plane);
-            if (slot != 0 && (!outer || std::abs(fitted[slot].normal.z()) >= kLevelNormal)) consider(slot);
+            if (slot != 0 && (!outer || std::abs(fitted[slot].normal.z()) >= kLevelCosine)) consider(slot);
           }
         }
       }
@@ -246,20 +245,16 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   };
   // How far each patch's outline reaches past the planes round it (behindEdge).
   std::vector<const std::vector<Eigen::Vector3d>*> outline_of_slot(slots, nullptr);
-  for (const Plane& plane : planes) {
-    const std::uint32_t slot = plane.id > 0 ? slotOf(plane.id) : 0;
-    if (slot != 0 && outline_of_slot[slot] == nullptr) outline_of_slot[slot] = &plane.outline;
-  }
+  for (std::size_t slot = 1; slot < slots; ++slot)
+    if (plane_of_slot[slot] != nullptr) outline_of_slot[slot] = &plane_of_slot[slot]->outline;
   const OutlineReach outline_reach(outline_of_slot, fitted, 2.0 * reach);
   std::vector<std::int8_t> seen_from(slots, 0);
   if (!beams.origin_of_point.empty()) {
     seen_from = seenFrom(points, slot_of_point, fitted,
                          [&](std::size_t index) { return beams.origins[beams.origin_of_point[index]]; });
   } else {
-    for (const Plane& plane : planes) {
-      const std::uint32_t slot = plane.id > 0 ? slotOf(plane.id) : 0;
-      if (slot != 0) seen_from[slot] = levelSeenFrom(plane, fitted[slot]);
-    }
+    for (std::size_t slot = 1; slot < slots; ++slot)
+      if (plane_of_slot[slot] != nullptr) seen_from[slot] = levelSeenFrom(*plane_of_slot[slot], fitted[slot]);
   }
   // How high each patch reaches, from the points on it alone (patchHeights).
   std::vector<HeightRange> heights(slots);
@@ -283,7 +278,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     const auto at = map.findCellOf(q.x(), q.y());
     if (!at || !q.allFinite()) return false;
     const std::int32_t near =
-        std::abs(plane.normal.z()) >= kLevelNormal && byVerticalEnd(map, at, q.z(), reach) ? kNearLevel : kNear;
+        std::abs(plane.normal.z()) >= kLevelCosine && byVerticalEnd(map, at, q.z(), reach) ? kNearLevel : kNear;
     for (std::int32_t di = -near; di <= near; ++di)
       for (std::int32_t dj = -near; dj <= near; ++dj)
         for (const Block& block : map.blocks(CellIndex{at->i + di, at->j + dj}))
