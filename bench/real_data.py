@@ -246,10 +246,10 @@ def issue_counts(annotation, rows):
         key = "structural" if is_structural(surface) else "other"
         counts[key] += 1
         counts[key + "_found"] += int(is_found(surface, row))
-        # The class a user reads off a found surface's patch, against the kind marked.
-        if is_found(surface, row) and row.get("cls") is not None and surface["kind"] in CLASS_OF_KIND:
+        right = class_right(surface, row)
+        if right is not None:
             counts["classed"] += 1
-            counts["class_ok"] += int(row["cls"] == CLASS_OF_KIND[surface["kind"]])
+            counts["class_ok"] += int(right)
         counts["rms_ok"] += int(row["n10"] > 0 and not math.isnan(row["rms"]) and row["rms"] - row["own"] <= 0.005)
     return counts
 
@@ -259,13 +259,21 @@ CLASS_OF_KIND = dict(floor="floor", ceiling="ceiling", wall="wall", table="table
                      step="step")
 
 
+def class_right(surface, row):
+    """The class a user reads off a found surface's patch, against the kind marked: True or
+    False, None where the surface was not found, its patch has no class or its kind none."""
+    wanted = CLASS_OF_KIND.get(surface["kind"])
+    if not (wanted and is_found(surface, row) and row.get("cls") is not None):
+        return None
+    return row["cls"] == wanted
+
+
 def class_misses(annotation, results):
     """Per method, the found surfaces whose patch's class is not the kind marked: 'NAME (method): class'."""
     misses = []
     for method, result in results.items():
         for surface, row in zip(annotation["surfaces"], result["rows"]):
-            wanted = CLASS_OF_KIND.get(surface["kind"])
-            if is_found(surface, row) and row.get("cls") is not None and wanted and row["cls"] != wanted:
+            if class_right(surface, row) is False:
                 misses.append(f"{surface['name']} ({method}): {row['cls']}")
     return misses
 
