@@ -67,6 +67,10 @@ std::vector<std::int32_t> labelPoints(const MLMap& map, const Scan& scan) {
 
 namespace {
 
+// The third fit (refinePointLabels) replaces the second where at least this share of
+// the points that fit used lie away from the patch's edges: a majority.
+constexpr double kMinInnerShare = 0.5;
+
 // Point chunks of a fixed count, summed in chunk order: the same sums, bit for bit,
 // whatever the thread count.
 constexpr std::int64_t kChunks = 64;
@@ -273,6 +277,10 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     const std::vector<PcaSums> moments = patchMoments(points, slot_of_point, origin, inner);
     for (std::size_t slot = 1; slot < slots; ++slot) {
       const std::size_t before = fitted[slot].points;
+      // Mostly edge (a 17 cm riser between treads at 3 cm of range noise: half of it
+      // within their tolerance): the band left is too thin to hold the plane's tilt, and
+      // the corridor's risers at 3 cm noise came apart on such fits. Keep the second fit.
+      if (moments[slot].weight < kMinInnerShare * static_cast<double>(before)) continue;
       fitPlane(moments[slot], origin[slot], options, fitted[slot]);
       fitted[slot].points = before;
     }
