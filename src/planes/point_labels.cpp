@@ -258,15 +258,19 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   // and its count of points (edge ties go by it) stay the second fit's: the residuals
   // without the edges are the narrower, and 3 of them are too narrow for real scans'
   // heavier tails (PCL's, 3DTK's and OctoMap's walls lost 1-2 % of their points).
+  // The same pass finds the one patch each point lies on, where it lies on one (`sole`, for
+  // patchHeights below): the planes move by millimetres in the third fit.
+  std::vector<std::uint32_t> sole(points.size(), 0);
   {
     std::vector<std::uint8_t> at_edge(points.size(), 0);
 #pragma omp parallel for schedule(static)
     for (std::int64_t k = 0; k < count; ++k) {
       const auto index = static_cast<std::size_t>(k);
-      const std::uint32_t own = slot_of_point[index];
-      if (own == 0) continue;
       std::array<Candidate, kMaxCandidates> candidates;
       const std::size_t found = gather(index, Eigen::Vector3d::Zero(), candidates);
+      if (found == 1) sole[index] = candidates[0].slot;
+      const std::uint32_t own = slot_of_point[index];
+      if (own == 0) continue;
       for (std::size_t c = 0; c < found; ++c)
         if (candidates[c].slot != own &&
             std::abs(fitted[candidates[c].slot].normal.dot(fitted[own].normal)) < kEdgeCosine)
@@ -306,16 +310,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   }
   // How high each patch reaches, from the points on it alone (patchHeights).
   std::vector<HeightRange> heights(slots);
-  if (!beams.origin_of_point.empty()) {
-    std::vector<std::uint32_t> sole(points.size(), 0);  // the one patch a point lies on, else 0
-#pragma omp parallel for schedule(static)
-    for (std::int64_t k = 0; k < count; ++k) {
-      std::array<Candidate, kMaxCandidates> candidates;
-      const auto index = static_cast<std::size_t>(k);
-      if (gather(index, Eigen::Vector3d::Zero(), candidates) == 1) sole[index] = candidates[0].slot;
-    }
-    heights = patchHeights(points, sole, fitted, 2.0 * reach);
-  }
+  if (!beams.origin_of_point.empty()) heights = patchHeights(points, sole, fitted, 2.0 * reach);
   // Whether the beam meets a candidate's plane where its patch is: within the height its
   // own points reach and near one of its blocks (within the plane's tolerance of the
   // block's extent, in the cells round that place).
