@@ -251,8 +251,8 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   // patch round them that meets theirs (not parallel). The blocks along an edge collect
   // both surfaces' points, and the two fits above keep those within a band (then the
   // tolerance) of the plane, so a face leaned towards the floor at its foot and a top
-  // towards its front: the simulated corridor's bench front 0.85 deg, its top 0.8 cm off at
-  // the edge. A leaning plane puts the other surface's points near the edge within its
+  // towards its front: the simulated corridor's bench front 0.85 deg, a generated bench's
+  // top 1.2 deg and 4 mm off at the edge. A leaning plane puts the other surface's points near the edge within its
   // tolerance: single points of a wall, the floor or a table top on a face's patch (issue
   // 19's held-out measure; tests/test_point_labels.cpp). The plane moves, its tolerance
   // and its count of points (edge ties go by it) stay the second fit's: the residuals
