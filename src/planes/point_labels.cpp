@@ -195,6 +195,20 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   std::vector<double> along_tolerance =
       beams.origin_of_point.empty() ? std::vector<double>(slots, std::numeric_limits<double>::infinity())
                                     : alongTolerances(points, slot_of_point, fitted, beamOf, options.sigmas);
+  // Whether the cell holds, near height z, a level block that the detector gave to a patch
+  // that is not level: a face took the floor's strip in its column, where the floor's own
+  // blocks can lie two cells off (the simulated lab turned 2-10°: a floor point at a
+  // cabinet's foot had the face as its only candidate, and the face then touched the floor
+  // in issue 19's held-out measure). There, as by a vertical block's end, the level
+  // patches' blocks are looked for two cells round.
+  const auto byFaceFoot = [&](const CellIndex& cell, double z) {
+    for (const Block& block : map.blocks(cell)) {
+      if (block.plane <= 0 || block.isVertical() || z > block.height + reach || z < block.bottom() - reach) continue;
+      const std::uint32_t slot = slotOf(block.plane);
+      if (slot != 0 && std::abs(fitted[slot].normal.z()) < kLevelCosine) return true;
+    }
+    return false;
+  };
   // The patches each point lies on (within tolerance of their refitted planes), among its
   // collecting block's and those of the blocks round it that reach its height.
   // `tail` (optional): the patches whose planes lie beyond their tolerance but within
@@ -233,7 +247,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     if (slot_of_point[index] != 0) consider(slot_of_point[index]);
     const auto cell = map.findCellOf(p.x(), p.y());
     if (cell && p.allFinite()) {
-      const std::int32_t near = byVerticalEnd(map, cell, p.z(), reach) ? kNearLevel : kNear;
+      const std::int32_t near = byVerticalEnd(map, cell, p.z(), reach) || byFaceFoot(*cell, p.z()) ? kNearLevel : kNear;
       for (std::int32_t di = -near; di <= near; ++di) {
         for (std::int32_t dj = -near; dj <= near; ++dj) {
           const bool outer = std::max(std::abs(di), std::abs(dj)) > kNear;
