@@ -436,7 +436,7 @@ TEST_CASE("Point labels: a box's faces are refitted without the points at its ed
   const std::vector<PointPlane> fitted =
       refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, scanned.options(), scanned.beams());
   std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, scanned.truth);
-  // True planes: 0-5 the room, 6 the top (z = 0.9), 7 the front (x = 0.6).
+  // True planes: 0-5 the room, 6 the top (z = 0.45), 7 the front (x = 0.4).
   const auto fitOf = [&](std::int32_t surface) -> const PointPlane* {
     for (const PointPlane& plane : fitted)
       if (surface_of.count(plane.id) && surface_of[plane.id] == surface) return &plane;
@@ -446,7 +446,7 @@ TEST_CASE("Point labels: a box's faces are refitted without the points at its ed
   const PointPlane* front = fitOf(7);
   REQUIRE(top != nullptr);
   REQUIRE(front != nullptr);
-  // Where the two faces meet, (0.6, 2.5, 0.9): each plane within 3 mm of it, and within
+  // Where the two faces meet, (0.4, 2.5, 0.45): each plane within 3 mm of it, and within
   // 0.3 deg of its true direction.
   const Point edge(0.4, 2.5, 0.45);
   MESSAGE("top " << top->normal.transpose() << " at the edge " << top->normal.dot(edge) + top->offset << "; front "

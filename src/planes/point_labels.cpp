@@ -272,39 +272,40 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   // and its count of points (edge ties go by it) stay the second fit's: the residuals
   // without the edges are the narrower, and 3 of them are too narrow for real scans'
   // heavier tails (PCL's, 3DTK's and OctoMap's walls lost 1-2 % of their points).
-  // The same pass finds the one patch each point lies on, where it lies on one (`sole`, for
-  // patchHeights below): the planes move by millimetres in the third fit.
-  std::vector<std::uint32_t> sole(points.size(), 0);
+  // With beams, the same pass finds the one patch each point lies on, where it lies on one
+  // (`sole`, for patchHeights below): the planes move by millimetres in the third fit.
+  const bool heights_wanted = !beams.origin_of_point.empty();
+  std::vector<std::uint32_t> sole(heights_wanted ? points.size() : 0, 0);
   {
     std::vector<std::uint8_t> at_edge(points.size(), 0);
 #pragma omp parallel for schedule(static)
     for (std::int64_t k = 0; k < count; ++k) {
       const auto index = static_cast<std::size_t>(k);
+      const std::uint32_t own = slot_of_point[index];
+      if (own == 0 && !heights_wanted) continue;
       std::array<Candidate, kMaxCandidates> candidates;
       const std::size_t found = gather(index, Eigen::Vector3d::Zero(), candidates);
-      if (found == 1) sole[index] = candidates[0].slot;
-      const std::uint32_t own = slot_of_point[index];
+      if (heights_wanted && found == 1) sole[index] = candidates[0].slot;
       if (own == 0) continue;
       for (std::size_t c = 0; c < found; ++c)
         if (candidates[c].slot != own &&
             std::abs(fitted[candidates[c].slot].normal.dot(fitted[own].normal)) < kEdgeCosine)
           at_edge[index] = 1;
     }
-    const std::vector<PointPlane> previous = fitted;
+    // The second fit's planes: `fitted` changes only once the moments are summed.
     const auto inner = [&](std::uint32_t slot, std::size_t index) {
-      return at_edge[index] == 0 && planeDistance(previous[slot], points[index]) <= previous[slot].tolerance;
+      return at_edge[index] == 0 && planeDistance(fitted[slot], points[index]) <= fitted[slot].tolerance;
     };
     const std::vector<PcaSums> moments = patchMoments(points, slot_of_point, origin, inner);
     for (std::size_t slot = 1; slot < slots; ++slot) {
-      const std::size_t before = fitted[slot].points;
       // Mostly edge (a 17 cm riser between treads at 3 cm of range noise: half of it
       // within their tolerance): the band left is too thin to hold the plane's tilt, and
       // the corridor's risers at 3 cm noise came apart on such fits. Keep the second fit.
-      if (moments[slot].weight < kMinInnerShare * static_cast<double>(before)) continue;
-      const double tolerance = fitted[slot].tolerance;
-      fitPlane(moments[slot], origin[slot], options, fitted[slot]);
-      fitted[slot].points = before;
-      fitted[slot].tolerance = tolerance;
+      if (moments[slot].weight < kMinInnerShare * static_cast<double>(fitted[slot].points)) continue;
+      PointPlane refit = fitted[slot];
+      fitPlane(moments[slot], origin[slot], options, refit);
+      fitted[slot].normal = refit.normal;  // the plane alone: tolerance and count stay
+      fitted[slot].offset = refit.offset;
     }
     if (!beams.origin_of_point.empty())
       along_tolerance = alongTolerances(points, slot_of_point, fitted, beamOf, options.sigmas);
@@ -324,7 +325,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   }
   // How high each patch reaches, from the points on it alone (patchHeights).
   std::vector<HeightRange> heights(slots);
-  if (!beams.origin_of_point.empty()) heights = patchHeights(points, sole, fitted, 2.0 * reach);
+  if (heights_wanted) heights = patchHeights(points, sole, fitted, 2.0 * reach);
   // Whether the beam meets a candidate's plane where its patch is: within the height its
   // own points reach and near one of its blocks (within the plane's tolerance of the
   // block's extent, in the cells round that place).
