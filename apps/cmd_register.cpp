@@ -148,7 +148,7 @@ void addRegisterCommand(CLI::App& app, Context& context) {
       ->default_val("point-to-plane");
   command->add_option("--voxel-size", options->config.source_voxel_size,
                       "Down-sampling of the scan being registered, m")
-      ->default_val(0.1)
+      ->default_val(0.05)
       ->check(CLI::PositiveNumber);
   command->add_option("--map-voxel-size", options->config.map_voxel_size,
                       "OcTree resolution of the map's nearest-neighbour grid, m")

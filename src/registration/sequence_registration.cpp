@@ -120,7 +120,8 @@ VerifiedIcp SequenceRegistration::addScan(const std::vector<Point>& points, cons
   map_.addPoints(transformed(dense, pose));
   map_.estimateNormals(config_.normals);
   dense_.push_back(std::move(dense));
-  sources_.push_back(std::move(source));
+  // The source sample down-sampled again (cheaper than the whole scan, the same voxels' points).
+  sources_.push_back(voxelDownSample(source, config_.pair_voxel_size, 0.0, std::numeric_limits<double>::infinity()));
   odometry_.push_back(odometry);
   poses_.push_back(pose);
   chain_.push_back(pose);
