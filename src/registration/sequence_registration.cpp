@@ -254,20 +254,20 @@ std::vector<std::vector<double>> SequenceRegistration::scanResiduals(
     const std::vector<Pose>& poses, const std::vector<std::vector<std::size_t>>& neighbours,
     const std::vector<VoxelHashMap>& locals, const std::vector<double>& noise,
     const std::vector<double>& source_noise) const {
-  std::vector<std::vector<double>> residuals(sources_.size());
+  std::vector<std::vector<double>> residuals(dense_.size());
   const double target_noise = noise.empty() ? 0.0 : *std::max_element(noise.begin(), noise.end());
 #pragma omp parallel for schedule(dynamic, 1)
-  for (long jj = 0; jj < static_cast<long>(sources_.size()); ++jj) {
+  for (long jj = 0; jj < static_cast<long>(dense_.size()); ++jj) {
     const auto j = static_cast<std::size_t>(jj);
     // Residuals beyond a few σ are points the other scans do not see: they count as that
     // bound, so a pose that moves a point out of overlap gains nothing.
     const double bound = kResidualSigmas * std::hypot(target_noise, source_noise[j]);
     std::vector<double>& out = residuals[j];
-    out.assign(sources_[j].size(), bound * bound);
+    out.assign(dense_[j].size(), bound * bound);
     for (const std::size_t i : neighbours[j]) {
       const Pose relative = poses[i].inverse() * poses[j];
-      for (std::size_t k = 0; k < sources_[j].size(); ++k) {
-        const Point moved = relative * sources_[j][k];
+      for (std::size_t k = 0; k < dense_[j].size(); ++k) {
+        const Point moved = relative * dense_[j][k];
         const std::optional<Neighbour> neighbour = locals[i].nearest(moved, config_.icp.min_max_distance);
         if (!neighbour || neighbour->normal.isZero()) continue;
         const double r = neighbour->normal.dot(moved - neighbour->point);

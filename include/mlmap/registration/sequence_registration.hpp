@@ -92,8 +92,10 @@ class SequenceRegistration {
   const SequenceConfig& config() const { return config_; }
 
  private:
-  // Per scan, per source point: its truncated squared point-to-plane residual against the
-  // nearest surface of the scans `neighbours[j]` lists, all at `poses`.
+  // Per scan, per point of its dense sample: its truncated squared point-to-plane residual
+  // against the nearest surface of the scans `neighbours[j]` lists, all at `poses`. The dense
+  // sample, not the pairs' coarser one: measured at 0.1 m the test kept a corridor's graph
+  // poses 0.07 deg worse than scan-to-map (tests/test_sequence_registration.cpp).
   std::vector<std::vector<double>> scanResiduals(const std::vector<Pose>& poses,
                                                  const std::vector<std::vector<std::size_t>>& neighbours,
                                                  const std::vector<VoxelHashMap>& locals,
