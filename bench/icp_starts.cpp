@@ -102,6 +102,7 @@ int runIcpStarts(int argc, char** argv) {
         run["noise"] = result.noise;
         run["first_matched"] = result.first_matched_share;
         run["eigenvalue_ratio"] = result.check.eigenvalue_ratio;
+        run["rotation_ratio"] = result.check.rotation_ratio;
         run["unconstrained"] = result.unconstrained;
         run["no_overlap"] = result.no_overlap;
         run["ambiguous"] = result.ambiguous;
