@@ -68,6 +68,7 @@ MapRegistration registerMaps(const Map& base, const Map& other, const Pose& init
   // cell (uniform over it: cell / √12), whatever the scans' range noise was.
   basin.min_noise = std::max(basin.min_noise, cell_size / std::sqrt(12.0));
   basin.max_start_translation = std::max(basin.max_start_translation, config.max_start_translation);
+  basin.levelled = true;  // the result is levelled about its samples (levelledAbout)
 
   // The walls' dominant directions give the turn between the frames (modulo a quarter
   // turn): a start that needs no yaw retry, where the retries cost a wide ICP run each

@@ -128,6 +128,7 @@ Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMa
         full.bottomRightCorner<3, 3>().completeOrthogonalDecomposition().solve(full.bottomLeftCorner<3, 3>());
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> turns(rotation, Eigen::EigenvaluesOnly);
     check.rotation_ratio = largest > 0.0 ? std::max(0.0, turns.eigenvalues()[0]) / largest : 0.0;
+    check.yaw_ratio = largest > 0.0 ? std::max(0.0, rotation(2, 2)) / largest : 0.0;
   }
   check.constrained = check.eigenvalue_ratio >= config.min_eigenvalue_ratio;
   check.translation_information = Matrix6d(hessian.selfadjointView<Eigen::Lower>()).bottomRightCorner<3, 3>();
@@ -197,7 +198,7 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
                                  along - config.max_start_translation, along + config.max_start_translation, step);
     check.constrained = check.profile.peaked &&
                         check.eigenvalue_ratio >= config.rotation_ratio_share * config.min_eigenvalue_ratio &&
-                        check.rotation_ratio >= config.min_eigenvalue_ratio;
+                        (config.levelled ? check.yaw_ratio : check.rotation_ratio) >= config.min_eigenvalue_ratio;
     return check;
   };
 
@@ -380,11 +381,13 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
                   "no overlap: only %.1f %% of the points lie within %.0f cm of the target after the first run",
                   100.0 * out.first_matched_share, 100.0 * gate);
     out.reason = text;
-  } else if (out.unconstrained && out.check.rotation_ratio < config.min_eigenvalue_ratio) {
+  } else if (out.unconstrained && (config.levelled ? out.check.yaw_ratio : out.check.rotation_ratio) <
+                                       config.min_eigenvalue_ratio) {
     std::snprintf(text, sizeof text,
                   "unconstrained: the result explains %.0f %% of the points but the geometry leaves a turn "
                   "free (rotation eigenvalue ratio %.1e < %.1e)",
-                  100.0 * out.check.explained_share, out.check.rotation_ratio, config.min_eigenvalue_ratio);
+                  100.0 * out.check.explained_share,
+                  config.levelled ? out.check.yaw_ratio : out.check.rotation_ratio, config.min_eigenvalue_ratio);
     out.reason = text;
   } else if (out.unconstrained) {
     std::snprintf(text, sizeof text,
