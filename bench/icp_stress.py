@@ -249,6 +249,20 @@ def scenes_for(split, which):
     return out
 
 
+def simulated_split(split, which, work, mlmap, env):
+    """(name, scene directory) of the split's scenes, simulated into `work` where not there yet."""
+    os.makedirs(work, exist_ok=True)
+    out = []
+    for name, scene in scenes_for(split, which):
+        scene_dir = os.path.join(work, name)
+        scene_json = os.path.join(work, name + ".json")
+        if not os.path.exists(os.path.join(scene_dir, "poses_true.txt")):
+            json.dump(scene, open(scene_json, "w"), indent=1)
+            run([mlmap, "--quiet", "simulate", scene_json, "-o", scene_dir], env)
+        out.append((name, scene_dir))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
@@ -276,12 +290,7 @@ def main():
     rows = []  # (scene, size, method, t_cm, r_deg, seconds, verified, attempts, unconstrained, first matched share)
     loads = [os.getloadavg()[0]]
     started = time.time()
-    for name, scene in scenes_for(a.split, a.scenes.split(",")):
-        scene_dir = os.path.join(work, name)
-        scene_json = os.path.join(work, name + ".json")
-        if not os.path.exists(os.path.join(scene_dir, "poses_true.txt")):
-            json.dump(scene, open(scene_json, "w"), indent=1)
-            run([mlmap, "--quiet", "simulate", scene_json, "-o", scene_dir], env)
+    for name, scene_dir in simulated_split(a.split, a.scenes.split(","), work, mlmap, env):
         true = read_tum(os.path.join(scene_dir, "poses_true.txt"))
         rng = np.random.default_rng(sum(map(ord, name)) + {"tune": 0, "report": 7919, "fresh": 15838}[a.split])
         count = len(true) - 1
