@@ -1,11 +1,15 @@
 #include "mlmap/registration/sequence_registration.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 
+#include "mlmap/error.hpp"
+#include "mlmap/registration/floor_calibration.hpp"
 #include "mlmap/registration/preprocessing.hpp"
 
 namespace mlmap::registration {
@@ -116,6 +120,20 @@ VerifiedIcp SequenceRegistration::addScan(const std::vector<Point>& points, cons
     const Pose guess = poses_.back() * (odometry_.back().inverse() * odometry);
     result = alignVerified(source, map_, guess, config_.icp, config_.basin);
     pose = result.icp.pose;
+    // Where the geometry leaves a direction free, the scan's own floor holds its tilt and
+    // height (a room whose scans share little floor: ICP keeps a weak tilt where the odometry
+    // put it, up to a degree off per step).
+    if (result.unconstrained && reference_floor_) {
+      if (const std::optional<Floor> floor = floorOf(source)) {
+        pose = result.icp.pose = levelledOnFloor(pose, *floor, source);
+      }
+    }
+  }
+  if (config_.level_from_floor && !reference_floor_) {
+    if (const std::optional<Floor> floor = floorOf(source)) {
+      reference_floor_ = Floor{pose.linear() * floor->up, 0.0};
+      reference_floor_->height = reference_floor_->up.dot(pose * Eigen::Vector3d(-floor->height * floor->up));
+    }
   }
   map_.addPoints(transformed(dense, pose));
   map_.estimateNormals(config_.normals);
@@ -126,6 +144,34 @@ VerifiedIcp SequenceRegistration::addScan(const std::vector<Point>& points, cons
   poses_.push_back(pose);
   chain_.push_back(pose);
   return result;
+}
+
+std::optional<SequenceRegistration::Floor> SequenceRegistration::floorOf(const std::vector<Point>& source) const {
+  if (!config_.level_from_floor) return std::nullopt;
+  try {
+    const FloorCalibration floor = calibrateFromFloor(source);
+    if (floor.floor_points < config_.min_floor_points) return std::nullopt;
+    return Floor{floor.floor_normal, floor.floor_distance};
+  } catch (const Error&) {
+    return std::nullopt;  // no floor in view
+  }
+}
+
+Pose SequenceRegistration::levelledOnFloor(const Pose& pose, const Floor& floor, const std::vector<Point>& source) const {
+  const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(pose.linear() * floor.up, reference_floor_->up);
+  if (Eigen::AngleAxisd(turn).angle() > config_.max_level_turn_deg * std::numbers::pi / 180.0) return pose;
+  // Turned about the scan's centre, where ICP matched it (as merge levels a map about its samples).
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Point& point : source) centre += point;
+  centre = pose * (centre / static_cast<double>(std::max<std::size_t>(1, source.size())));
+  Pose levelled = pose;
+  levelled.linear() = turn.toRotationMatrix() * pose.linear();
+  levelled.translation() = centre + turn.toRotationMatrix() * (pose.translation() - centre);
+  // ... and set on the reference floor's height, unless it stands on another level.
+  const double height = reference_floor_->up.dot(levelled * Eigen::Vector3d(-floor.height * floor.up));
+  const double shift = reference_floor_->height - height;
+  if (std::abs(shift) <= config_.max_level_shift) levelled.translation() += shift * reference_floor_->up;
+  return levelled;
 }
 
 RefinementResult SequenceRegistration::refine() {

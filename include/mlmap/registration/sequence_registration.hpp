@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -30,6 +31,17 @@ struct SequenceConfig {
   // The cost: pairs 25 % slower (bench/icp_stress.py).
   double source_voxel_size = 0.05;
   double map_voxel_size = 0.1;       // m, OcTree resolution of the map's key grid
+  // A scan whose result leaves a direction free (unconstrained) is turned level with the
+  // first floor seen, by its own floor (calibrateFromFloor: at least min_floor_points), when
+  // that takes at most max_level_turn_deg, and set on that floor's height when that moves it at
+  // most max_level_shift (farther: another level). Its tilt and height are what such a result
+  // leaves free where the scans share little floor (the stress benchmark's fresh room-22:
+  // tests/test_sequence_floor.cpp). The bounds: the odometry's tilt error per step (1 deg in
+  // register_ate.py, 2 deg in the stress benchmark's starts) and a stair's rise (0.15-0.2 m).
+  bool level_from_floor = true;
+  std::size_t min_floor_points = 500;
+  double max_level_turn_deg = 3.0;
+  double max_level_shift = 0.1;
   // m, the refinement's sample of each scan (its pairs start from registered poses, and its
   // poses are kept only where they lower the residuals): at 0.05 m it took twice as long on
   // the simulated lab (1.2 -> 2.2 s) for the same poses.
@@ -106,6 +118,15 @@ class SequenceRegistration {
   VoxelHashMap map_;
   std::vector<Pose> odometry_;
   std::vector<Pose> poses_;
+  // A floor: its upward normal and its height along it (in the sensor frame: the sensor's
+  // height above it, the reference's: the floor's height in the world).
+  struct Floor {
+    Eigen::Vector3d up;
+    double height;
+  };
+  std::optional<Floor> floorOf(const std::vector<Point>& source) const;
+  Pose levelledOnFloor(const Pose& pose, const Floor& floor, const std::vector<Point>& source) const;
+  std::optional<Floor> reference_floor_;  // the first floor seen, world frame
   std::vector<Pose> chain_;                  // the scan-to-map poses, before refinement
   std::vector<std::vector<Point>> sources_;  // sensor frame, down-sampled at pair_voxel_size
   std::vector<std::vector<Point>> dense_;    // sensor frame, down-sampled at map_voxel_size / 2
