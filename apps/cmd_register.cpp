@@ -68,9 +68,10 @@ int runRegister(RegisterOptions options, bool quiet) {
         stamped.push_back(guess);
         odometry_poses.push_back(guess.pose);
         // Printed for every scan (stdout): whether its result explains the overlap.
-        std::printf("scan %zu: %zu points, %zu/%zu inliers, RMS %.2f cm, %d iterations, %s\n", index, scan.size(),
+        std::printf("scan %zu: %zu points, %zu/%zu inliers, RMS %.2f cm, %d iterations, %s%s\n", index, scan.size(),
                     result.icp.inliers, result.icp.source_points, 100.0 * result.icp.rms_residual,
-                    result.icp.iterations, index == 0 ? "first scan (anchors the map)" : verificationSummary(result).c_str());
+                    result.icp.iterations, index == 0 ? "first scan (anchors the map)" : verificationSummary(result).c_str(),
+                    sequence.levelledOnFloor(index) ? "; tilt and height from its floor" : "");
         reports.push_back({index, options.input.scans[file], scan.size(), result});
       },
       [&](std::size_t file) { progress.update(file + 1, std::to_string(point_count) + " points"); });

@@ -75,6 +75,8 @@ TEST_CASE("SequenceRegistration: each scan's floor holds the tilt and height tha
     sequence.addScan(scans[k].scan.points, odometry);
     truth.push_back(scans[k].true_pose);
   }
+  CHECK(sequence.levelledOnFloor(2));  // the scan whose odometry is 9 cm low
+  CHECK_FALSE(sequence.levelledOnFloor(0));
   sequence.refine();
   const TrajectoryError error = trajectoryError(sequence.poses(), truth);
   CAPTURE(error.rms_translation);

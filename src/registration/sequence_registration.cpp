@@ -110,6 +110,7 @@ VerifiedIcp SequenceRegistration::addScan(const std::vector<Point>& points, cons
 
   VerifiedIcp result;
   Pose pose = odometry;
+  bool levelled = false;
   if (poses_.empty()) {
     result.icp.pose = result.start = result.kept_start = pose;
     result.icp.converged = true;
@@ -125,7 +126,9 @@ VerifiedIcp SequenceRegistration::addScan(const std::vector<Point>& points, cons
     // put it, up to a degree off per step).
     if (result.unconstrained && reference_floor_) {
       if (const std::optional<Floor> floor = floorOf(source)) {
-        pose = result.icp.pose = levelledOnFloor(pose, *floor, source);
+        const Pose on_floor = levelledOnFloor(pose, *floor, source);
+        levelled = !on_floor.isApprox(pose);
+        pose = result.icp.pose = on_floor;
       }
     }
   }
@@ -143,6 +146,7 @@ VerifiedIcp SequenceRegistration::addScan(const std::vector<Point>& points, cons
   odometry_.push_back(odometry);
   poses_.push_back(pose);
   chain_.push_back(pose);
+  levelled_.push_back(levelled);
   return result;
 }
 

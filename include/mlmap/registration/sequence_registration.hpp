@@ -103,6 +103,8 @@ class SequenceRegistration {
   RefinementResult refine();
 
   const std::vector<Pose>& poses() const { return poses_; }
+  // Whether scan `index` was levelled on its floor (level_from_floor) after its ICP.
+  bool levelledOnFloor(std::size_t index) const { return index < levelled_.size() && levelled_[index]; }
   const SequenceConfig& config() const { return config_; }
 
  private:
@@ -129,6 +131,7 @@ class SequenceRegistration {
   std::optional<Floor> floorOf(const std::vector<Point>& source) const;
   Pose levelledOnFloor(const Pose& pose, const Floor& floor, const std::vector<Point>& source) const;
   std::optional<Floor> reference_floor_;  // the first floor seen, world frame
+  std::vector<bool> levelled_;            // per scan: levelled on its floor
   std::vector<Pose> chain_;                  // the scan-to-map poses, before refinement
   std::vector<std::vector<Point>> sources_;  // sensor frame, down-sampled at pair_voxel_size
   std::vector<std::vector<Point>> dense_;    // sensor frame, down-sampled at map_voxel_size / 2
