@@ -1,5 +1,6 @@
 // mlmap register: scans + odometry poses -> corrected poses (TUM), by scan-to-map ICP and
 // a pose graph over overlapping pairs.
+#include <cstdint>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -160,6 +161,9 @@ void addRegisterCommand(CLI::App& app, Context& context) {
       ->default_val(0.5)
       ->check(CLI::PositiveNumber);
   command->add_flag("--no-refine", options->no_refine, "Scan-to-map only, no pose graph");
+  command->add_flag("--no-floor-level", [options](std::int64_t) { options->config.level_from_floor = false; },
+                    "Never take a scan's tilt and height from its own floor (a building whose floors are not "
+                    "level, e.g. ramps)");
   addNumber(command, "--scan-noise", options->scan_noise,
             "How far each scan's surfaces lie from where another scan sees them at the right pose, m; "
             "verification expects √2 times it between two scans (default: measured within each scan; "
