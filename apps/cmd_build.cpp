@@ -21,6 +21,7 @@ struct BuildOptions {
   double range_sigma = 0.0;
   bool register_scans = false;  // correct the poses by ICP before building
   double scan_noise = 0.0;      // m, for --register: 0 = measured within each scan
+  bool no_floor_level = false;  // for --register: SequenceConfig::level_from_floor off
 };
 
 // --register: one pass over the scans for scan-to-map ICP and the pose graph, from the
@@ -28,6 +29,7 @@ struct BuildOptions {
 std::vector<io::StampedPose> registeredPoses(const BuildOptions& options, const ScanReading& reading, bool quiet) {
   registration::SequenceConfig config;
   if (options.scan_noise > 0.0) config.basin.noise = config.basin.source_noise = options.scan_noise;
+  config.level_from_floor = !options.no_floor_level;
   registration::SequenceRegistration sequence(config);
   std::vector<io::StampedPose> corrected;
   const std::vector<io::StampedPose>& given = reading.sequence().poses();
@@ -106,6 +108,10 @@ void addBuildCommand(CLI::App& app, Context& context) {
             "With --register: how far each scan's surfaces lie from where another scan sees them, m "
             "(as `mlmap register --scan-noise`; default: measured within each scan)",
             0.0, Bound::Open)
+      ->needs(register_flag);
+  command->add_flag("--no-floor-level", options->no_floor_level,
+                    "With --register: never take a scan's tilt and height from its own floor (as `mlmap register "
+                    "--no-floor-level`)")
       ->needs(register_flag);
   addScanOptions(command, options->input,
                  {.poses_help = "TUM pose file, one pose per scan in order (scan i in the sensor frame, pose i "
