@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "mlmap/error.hpp"
+#include "mlmap/io/tum_poses.hpp"
 #include "mlmap/registration/up_axis.hpp"
 #include "number_options.hpp"
 
@@ -81,10 +82,16 @@ void ScanReading::resolveUp(const std::string& up) {
     sequence_ = io::ScanSequence(input);
     return;
   }
-  // auto, or the default: look at the first file.
+  // auto, or the default: look at the first file, and at every pose of a pose file (the
+  // turns of a sequence of one-scan files: the first file alone has none, and one tilting-laser
+  // scan of a narrow room faces its long walls more than its floor).
   std::vector<Scan> first;
   read([&](Scan& scan, std::size_t, std::size_t) { first.push_back(std::move(scan)); }, {}, 1);
-  const registration::UpAxisEstimate estimate = registration::estimateUpAxis(first);
+  std::vector<Pose> poses;
+  if (!input.poses.empty()) {
+    for (const io::StampedPose& stamped : io::readTumPoses(input.poses)) poses.push_back(input.world * stamped.pose);
+  }
+  const registration::UpAxisEstimate estimate = registration::estimateUpAxis(first, {}, poses);
   const bool z_up = estimate.up.z() > 0.5;
   const std::string evidence = std::string("from ") + cueName(estimate.line_from) + ": " +
                                std::to_string(static_cast<int>(100.0 * estimate.planar_share + 0.5)) +

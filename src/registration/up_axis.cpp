@@ -47,11 +47,11 @@ int snappedAxis(const Eigen::Vector3d& direction) {
   return largest >= kSnapCos * direction.norm() ? static_cast<int>(axis) : -1;
 }
 
-// The axis the scans turn about, when they turn: their rotations relative to the first.
-int turnAxis(const std::vector<Scan>& scans) {
+// The axis the poses turn about, when they turn: their rotations relative to the first.
+int turnAxis(const std::vector<Pose>& poses) {
   Eigen::Vector3d summed = Eigen::Vector3d::Zero();
-  for (std::size_t k = 1; k < scans.size(); ++k) {
-    const Eigen::AngleAxisd turn(scans[k].pose.linear() * scans.front().pose.linear().transpose());
+  for (std::size_t k = 1; k < poses.size(); ++k) {
+    const Eigen::AngleAxisd turn(poses[k].linear() * poses.front().linear().transpose());
     if (turn.angle() < kMinTurnRad) continue;
     const Eigen::Vector3d axis = turn.axis().dot(summed) < 0.0 ? Eigen::Vector3d(-turn.axis()) : turn.axis();
     summed += turn.angle() * axis;
@@ -61,7 +61,8 @@ int turnAxis(const std::vector<Scan>& scans) {
 
 }  // namespace
 
-UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig& config) {
+UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig& config,
+                              const std::vector<Pose>& sequence_poses) {
   std::size_t total = 0;
   for (const Scan& scan : scans) total += scan.size();
   const std::size_t stride = config.max_points == 0 ? 1 : std::max<std::size_t>(1, total / config.max_points + 1);
@@ -100,7 +101,11 @@ UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig
     below[static_cast<std::size_t>(axis)] += cell.below[static_cast<std::size_t>(axis)];
   }
 
-  int line = turnAxis(scans);
+  std::vector<Pose> poses = sequence_poses;
+  if (poses.empty()) {
+    for (const Scan& scan : scans) poses.push_back(scan.pose);
+  }
+  int line = turnAxis(poses);
   if (line >= 0) {
     estimate.line_from = UpCue::Poses;
   } else if (estimate.planar_cells >= kMinPlanarCells) {

@@ -33,8 +33,11 @@ struct UpAxisConfig {
   std::size_t max_points = 200000; // the scans are thinned evenly to at most this many
 };
 
-// From scans in their sensor frames with their world poses (the sensor origins).
-UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig& config = {});
+// From scans in their sensor frames with their world poses (the sensor origins); the turn
+// cue from `sequence_poses` where given (every scan's pose of a sequence of which `scans`
+// holds only the first: a pose file), else from the scans' own poses.
+UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig& config = {},
+                              const std::vector<Pose>& sequence_poses = {});
 
 // The rotation turning `up` (a signed coordinate axis) into +z: identity, a quarter
 // turn about x or y, or a half turn about x.
