@@ -73,7 +73,7 @@ int runRegister(RegisterOptions options, bool quiet) {
                     result.icp.inliers, result.icp.source_points, 100.0 * result.icp.rms_residual,
                     result.icp.iterations, index == 0 ? "first scan (anchors the map)" : verificationSummary(result).c_str(),
                     sequence.levelledOnFloor(index) ? "; tilt and height from its floor" : "");
-        reports.push_back({index, options.input.scans[file], scan.size(), result});
+        reports.push_back({index, options.input.scans[file], scan.size(), result, sequence.levelledOnFloor(index)});
       },
       [&](std::size_t file) { progress.update(file + 1, std::to_string(point_count) + " points"); });
   progress.finish(std::to_string(point_count) + " points");

@@ -64,6 +64,7 @@ void writeRegisterReport(const std::string& path, const std::vector<ScanReport>&
                             {"degenerate", r.icp.degenerate},
                             {"eigenvalue_ratio", r.icp.eigenvalue_ratio},
                             {"constrained_eigenvalue_ratio", r.check.eigenvalue_ratio},
+                            {"rotation_eigenvalue_ratio", r.check.rotation_ratio},
                             {"slide_profile", {{"direction", {r.check.profile.direction.x(), r.check.profile.direction.y(),
                                                               r.check.profile.direction.z()}},
                                                {"facing_points", r.check.profile.facing},
@@ -75,6 +76,7 @@ void writeRegisterReport(const std::string& path, const std::vector<ScanReport>&
                             {"slide_fit_m", r.slide_fit},
                             {"verified", r.verified},
                             {"unconstrained", r.unconstrained},
+                            {"levelled_on_floor", scan.levelled_on_floor},
                             {"no_overlap", r.no_overlap},
                             {"reason", r.reason}});
   }

@@ -16,6 +16,7 @@ struct ScanReport {
   std::string file;
   std::size_t points = 0;
   registration::VerifiedIcp result;
+  bool levelled_on_floor = false;  // SequenceRegistration::levelledOnFloor
 };
 
 // Written atomically; `refinement` may be null (--no-refine).

@@ -2,6 +2,7 @@
 #include <doctest/doctest.h>
 
 #include <cstdio>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
@@ -61,6 +62,21 @@ TEST_CASE("CLI: the lab scene goes from simulate to build to info") {
   CHECK(info["bounds"]["max"][1].get<double>() - info["bounds"]["min"][1].get<double>() ==
         doctest::Approx(11.4).epsilon(0.05));
   CHECK(info["octree"]["occupied_leaves"].get<int>() > 1000);
+  // register --report: the per-scan figures as JSON, every scan of the lab verified (its walls
+  // hold every turn), none taken from its floor (only unconstrained results are).
+  result = runCli("--quiet register --poses " + out + "/poses_odom.txt -o " + out + "/poses_icp.txt --report " + out +
+                  "/report.json" + scans);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  std::ifstream report_file(out + "/report.json");
+  const auto report = nlohmann::json::parse(report_file);
+  REQUIRE(report["scans"].size() == 8);
+  for (std::size_t k = 1; k < 8; ++k) {
+    const auto& scan = report["scans"][k];
+    CAPTURE(k);
+    CHECK(scan["verified"].get<bool>());
+    CHECK_FALSE(scan["levelled_on_floor"].get<bool>());
+    CHECK(scan["rotation_eigenvalue_ratio"].get<double>() >= 7.5e-3);
+  }
 }
 
 TEST_CASE("CLI: bad input ends with one line naming the file, exit code 1, no output file") {
