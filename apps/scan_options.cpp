@@ -5,7 +5,6 @@
 #include <filesystem>
 
 #include "mlmap/error.hpp"
-#include "mlmap/io/tum_poses.hpp"
 #include "mlmap/registration/up_axis.hpp"
 #include "number_options.hpp"
 
@@ -88,9 +87,7 @@ void ScanReading::resolveUp(const std::string& up) {
   std::vector<Scan> first;
   read([&](Scan& scan, std::size_t, std::size_t) { first.push_back(std::move(scan)); }, {}, 1);
   std::vector<Pose> poses;
-  if (!input.poses.empty()) {
-    for (const io::StampedPose& stamped : io::readTumPoses(input.poses)) poses.push_back(input.world * stamped.pose);
-  }
+  for (const io::StampedPose& stamped : sequence_.poses()) poses.push_back(input.world * stamped.pose);
   const registration::UpAxisEstimate estimate = registration::estimateUpAxis(first, {}, poses);
   const bool z_up = estimate.up.z() > 0.5;
   const std::string evidence = std::string("from ") + cueName(estimate.line_from) + ": " +

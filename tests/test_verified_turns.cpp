@@ -20,8 +20,11 @@
 #include "mlmap/registration/verified_icp.hpp"
 #include "mlmap/sim/scene.hpp"
 #include "mlmap/sim/simulator.hpp"
+#include "verified_pairs.hpp"
 
 using namespace mlmap::registration;
+using mlmap::test::rotationErrorDeg;
+using mlmap::test::translationError;
 
 namespace {
 
@@ -61,8 +64,6 @@ struct StartError {
   double roll_deg, pitch_deg, yaw_deg;
 };
 
-double degrees(double radians) { return radians * 180.0 / std::numbers::pi; }
-
 // The start: the true relative pose turned about the sensor by the error's rotation and moved
 // by its translation (as bench/icp_stress.py makes them).
 mlmap::Pose startFrom(const mlmap::Pose& truth, const StartError& error) {
@@ -91,10 +92,6 @@ VerifiedIcp alignPair(const std::vector<mlmap::sim::SimulatedScan>& scans, std::
   return alignVerified(points, map, start, config.icp, config.basin);
 }
 
-double rotationErrorDeg(const mlmap::Pose& a, const mlmap::Pose& b) {
-  return degrees(Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle());
-}
-
 }  // namespace
 
 TEST_CASE("alignVerified: a pair whose shared surfaces leave roll and pitch weak is not verified") {
@@ -109,7 +106,7 @@ TEST_CASE("alignVerified: a pair whose shared surfaces leave roll and pitch weak
   for (const StartError& error : starts) {
     const VerifiedIcp result = alignPair(scans, 1, 2, startFrom(truth, error));
     const double rotation_error = rotationErrorDeg(result.icp.pose, truth);
-    const double translation_error = (result.icp.pose.translation() - truth.translation()).norm();
+    const double translation_error = translationError(result.icp.pose, truth);
     CAPTURE(error.yaw_deg);
     CAPTURE(rotation_error);
     CAPTURE(translation_error);
@@ -132,5 +129,5 @@ TEST_CASE("alignVerified: a pair of the same room that holds every turn still ve
   CAPTURE(result.check.rotation_ratio);
   CHECK(result.verified);
   CHECK(rotationErrorDeg(result.icp.pose, truth) < 0.2);
-  CHECK((result.icp.pose.translation() - truth.translation()).norm() < 0.01);
+  CHECK(translationError(result.icp.pose, truth) < 0.01);
 }

@@ -62,6 +62,11 @@ double distanceFrom(const Pose& start, const Pose& pose, double radius) {
   return delta.translation().norm() + radius * Eigen::AngleAxisd(delta.linear()).angle();
 }
 bool verifiedCheck(const Verification& check) { return check.good && check.constrained; }
+// The ratio of the turns the result must hold: all three, or the yaw alone where its tilt is
+// dropped (BasinConfig::levelled).
+double heldTurnRatio(const Verification& check, const BasinConfig& config) {
+  return config.levelled ? check.yaw_ratio : check.rotation_ratio;
+}
 bool better(const Verification& a, double a_distance, const Verification& b, double b_distance) {
   if (verifiedCheck(a) != verifiedCheck(b)) return verifiedCheck(a);
   if (a.good != b.good) return a.good;
@@ -118,12 +123,13 @@ Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMa
     jacobian << (pose * source[k] - pivot).cross(normals[k]) / radius, normals[k];
     hessian.selfadjointView<Eigen::Lower>().rankUpdate(jacobian);
   }
+  const Matrix6d full = hessian.selfadjointView<Eigen::Lower>();
   if (check.explained > 0) {
-    const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(Matrix6d(hessian.selfadjointView<Eigen::Lower>()),
-                                                         Eigen::EigenvaluesOnly);
+    const Eigen::SelfAdjointEigenSolver<Matrix6d> solver(full, Eigen::EigenvaluesOnly);
     const double largest = solver.eigenvalues()[5];
     check.eigenvalue_ratio = largest > 0.0 ? std::max(0.0, solver.eigenvalues()[0]) / largest : 0.0;
-    const Matrix6d full = hessian.selfadjointView<Eigen::Lower>();
+    // The turns' information with the translations left free (the Schur complement): what the
+    // points hold of a turn that a shift cannot undo; the slide profile tests the shifts.
     const Eigen::Matrix3d rotation = full.topLeftCorner<3, 3>() - full.topRightCorner<3, 3>() *
         full.bottomRightCorner<3, 3>().completeOrthogonalDecomposition().solve(full.bottomLeftCorner<3, 3>());
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> turns(rotation, Eigen::EigenvaluesOnly);
@@ -131,7 +137,7 @@ Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMa
     check.yaw_ratio = largest > 0.0 ? std::max(0.0, rotation(2, 2)) / largest : 0.0;
   }
   check.constrained = check.eigenvalue_ratio >= config.min_eigenvalue_ratio;
-  check.translation_information = Matrix6d(hessian.selfadjointView<Eigen::Lower>()).bottomRightCorner<3, 3>();
+  check.translation_information = full.bottomRightCorner<3, 3>();
   check.matched = matched.size();
   check.explained_share =
       source.empty() ? 0.0 : static_cast<double>(check.explained) / static_cast<double>(source.size());
@@ -198,7 +204,7 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
                                  along - config.max_start_translation, along + config.max_start_translation, step);
     check.constrained = check.profile.peaked &&
                         check.eigenvalue_ratio >= config.rotation_ratio_share * config.min_eigenvalue_ratio &&
-                        (config.levelled ? check.yaw_ratio : check.rotation_ratio) >= config.min_eigenvalue_ratio;
+                        heldTurnRatio(check, config) >= config.min_eigenvalue_ratio;
     return check;
   };
 
@@ -381,13 +387,11 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
                   "no overlap: only %.1f %% of the points lie within %.0f cm of the target after the first run",
                   100.0 * out.first_matched_share, 100.0 * gate);
     out.reason = text;
-  } else if (out.unconstrained && (config.levelled ? out.check.yaw_ratio : out.check.rotation_ratio) <
-                                       config.min_eigenvalue_ratio) {
+  } else if (out.unconstrained && heldTurnRatio(out.check, config) < config.min_eigenvalue_ratio) {
     std::snprintf(text, sizeof text,
                   "unconstrained: the result explains %.0f %% of the points but the geometry leaves a turn "
                   "free (rotation eigenvalue ratio %.1e < %.1e)",
-                  100.0 * out.check.explained_share,
-                  config.levelled ? out.check.yaw_ratio : out.check.rotation_ratio, config.min_eigenvalue_ratio);
+                  100.0 * out.check.explained_share, heldTurnRatio(out.check, config), config.min_eigenvalue_ratio);
     out.reason = text;
   } else if (out.unconstrained) {
     std::snprintf(text, sizeof text,
