@@ -210,11 +210,39 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
       plane.label = PlaneClass::Table;
     }
   }
+  // Tilted patches low enough for one step's band, a riser apart and side by side, three
+  // or more: a flight seen from below, each step its riser and nosing (stepped.hpp cuts a
+  // ramp through them into these bands).
+  std::vector<std::size_t> bands;
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    const double up = std::abs(planes[k].normal.z());
+    if (up < cos_horizontal && up > sin_vertical &&
+        extents[k].max.z() - extents[k].min.z() <= config.riser_max + config.level_tolerance)
+      bands.push_back(k);
+  }
+  std::vector<std::uint8_t> in_flight(planes.size(), 0);
+  for (const std::size_t start : bands) {
+    if (in_flight[start] != 0) continue;
+    std::vector<std::size_t> flight{start};
+    in_flight[start] = 2;
+    for (std::size_t n = 0; n < flight.size(); ++n) {
+      for (const std::size_t k : bands) {
+        const double rise = std::abs(planes[k].centroid.z() - planes[flight[n]].centroid.z());
+        if (in_flight[k] == 0 && rise >= config.riser_min && rise <= config.riser_max &&
+            neighbours(extents[k], extents[flight[n]], config.neighbour_gap)) {
+          in_flight[k] = 2;
+          flight.push_back(k);
+        }
+      }
+    }
+    if (flight.size() >= 3)
+      for (const std::size_t member : flight) in_flight[member] = 1;
+  }
   for (std::size_t k = 0; k < planes.size(); ++k) {
     Plane& plane = planes[k];
     if (std::abs(plane.normal.z()) >= cos_horizontal) continue;
     if (std::abs(plane.normal.z()) > sin_vertical) {
-      plane.label = PlaneClass::Other;
+      plane.label = in_flight[k] == 1 ? PlaneClass::Step : PlaneClass::Other;
       continue;
     }
     const double height = extents[k].max.z() - extents[k].min.z();

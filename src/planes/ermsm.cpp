@@ -11,6 +11,7 @@
 #include "bevels.hpp"
 #include "creases.hpp"
 #include "curved.hpp"
+#include "stepped.hpp"
 #include "detector.hpp"
 #include "median.hpp"
 #include "mlmap/planes/block_grid.hpp"
@@ -205,6 +206,7 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
     // A strip of a pillar or a round wall is no plane (curved.hpp); before the crease
     // split, which would cut it into faces.
     dropCurved(grid, patches, radians(config.kappa_deg));
+    splitSteps(grid, patches, {config.noise, config.min_patch_blocks, config.min_patch_area});
     const std::vector<int> faces_of = splitCreases(
         grid, patches,
         {config.noise, config.epsilon, radians(config.kappa_deg), config.min_patch_blocks, config.min_patch_area});
@@ -225,6 +227,8 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
                            std::max<double>(1.0, blocks[k].points.count)});
     }
   }
+  // The steps and faces cut above have no outline yet: classification reads their extents.
+  tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));
   classifyPlanes(patches.planes, {}, bottoms);
   mergeLevels(grid, patches, radians(config.kappa_deg), sheets ? config.noise : 0.0);
   labelCeilingPieces(patches.planes);

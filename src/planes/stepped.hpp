@@ -1,0 +1,42 @@
+// Internal to eRMSM, beyond the paper: no ramp through a staircase. Seen from the floor a
+// staircase shows its risers and nosings, a band of scan lines every step, and a plane
+// tilted at the flight's slope passes within ε of all of them (OctoMap's fr079 scan: 13
+// steps of 0.13 m, one patch tilted 23° at 10 cm cells, pieces of such ramps at 5 cm).
+// Its blocks tell it apart: each holds a piece of one riser, whose points spread along
+// the ramp's normal by the riser's height, where a flat surface's spread by the noise.
+#pragma once
+
+#include "patch_set.hpp"
+
+namespace mlmap {
+
+struct StepConfig {
+  double noise = 0.0;     // m, σ; 0: nothing is split or dropped
+  int min_blocks = 6;     // a step's patch needs as many blocks (ErmsmConfig::min_patch_blocks)
+  double min_area = 0.0;  // m², and as much surface (ErmsmConfig::min_patch_area)
+};
+
+// Each patch tilted between the classes' level and plumb tolerances
+// (ClassifyConfig::horizontal_deg: a ramp is neither floor nor wall) whose blocks' points
+// spread along its normal, pooled over its blocks, by more than twice σ (the limit
+// describePatch sets for a block holding one surface) is a staircase. It is cut into its
+// steps along its fall line, where its blocks' points thin out between two steps' bands
+// (a window of a cell: a riser's points share one position along the fall line). A step
+// keeps its own patch, on its own plane, where it is as large as a patch must be and about
+// as flat (its own spread within 3 σ: a step's band is an edge, its riser and nosing). With
+// two such steps or more the ramp is cut: its other blocks go back to no patch, the first
+// step takes its id and the others are appended; with fewer it stays as it was (one riser
+// whose patch took the edge of the tread above it is no staircase). Needs the blocks'
+// point moments. Returns the number of ramps cut.
+std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& config);
+
+// The blocks' points' spread along `normal` (unit), m: the root of their scatter along it
+// pooled over the blocks (each block's about its own mean), and the degrees of freedom it
+// rests on (points less one per block of two points or more).
+struct BlockSpread {
+  double rms = 0.0;
+  double dof = 0.0;
+};
+BlockSpread spreadAlong(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal);
+
+}  // namespace mlmap

@@ -1,0 +1,160 @@
+// A staircase seen from its foot (issue 19, OctoMap's fr079 scan): a scanner near floor
+// level sees each riser as a few scan lines and none of the treads. A plane tilted at the
+// flight's slope passes within ε of every riser, and the detector laid one patch through
+// all of them (fr079 at 10 cm cells: one 'other' patch 23° off level over its 13 steps).
+// Such a patch is cut into its steps now (src/planes/stepped.hpp): each of its blocks
+// holds a piece of one riser, spread along the ramp's normal by the riser's height, where
+// a real ramp's blocks spread by the noise, and the ramp stays.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "../src/planes/stepped.hpp"
+#include "mlmap/planes/block_grid.hpp"
+#include "mlmap/planes/classify.hpp"
+#include "patch_pieces.hpp"
+#include "plane_scenes.hpp"
+
+using namespace mlmap;
+
+namespace {
+
+constexpr int kRisers = 10;
+constexpr double kRise = 0.16;   // m
+constexpr double kGoing = 0.28;  // m, riser to riser
+constexpr double kFirst = 0.07;  // m, the first riser's x: off the cell boundaries
+constexpr double kWidth = 4.0;   // m, along y
+constexpr double kNoise = 0.008;
+constexpr double kKappa = 25.0 * std::numbers::pi / 180.0;
+
+double riserX(int k) { return kFirst + k * kGoing; }
+
+// Each riser seen as five scan lines 3 cm apart, a point every 6-10 cm along y, 8 mm of
+// range noise (along x).
+test::PlaneSceneBuilder risersFromBelow(double cell, unsigned seed) {
+  test::PlaneSceneBuilder scene(cell, kNoise, seed);
+  std::mt19937 random(seed);
+  std::normal_distribution<double> noise(0.0, kNoise);
+  std::uniform_real_distribution<double> gap(0.06, 0.10);
+  for (int k = 0; k < kRisers; ++k) {
+    for (int line = 0; line < 5; ++line) {
+      const double z = k * kRise + 0.02 + line * 0.03;
+      for (double y = -kWidth / 2 + gap(random) / 2; y < kWidth / 2; y += gap(random)) {
+        scene.map().insert(Point{riserX(k) + noise(random), y, z}, kNoise * kNoise);
+      }
+    }
+  }
+  return scene;
+}
+
+// Which riser block `id`'s points belong to (by their mean x), or -1.
+int riserOf(const BlockGrid& grid, std::uint32_t id) {
+  const double x = grid.pointsFrameOf(id).x() + grid.pointsOf(id).mean_x;
+  for (int k = 0; k < kRisers; ++k) {
+    if (std::abs(x - riserX(k)) < 0.1) return k;
+  }
+  return -1;
+}
+
+std::vector<std::uint32_t> allBlocks(const BlockGrid& grid) {
+  std::vector<std::uint32_t> ids(grid.size());
+  for (std::uint32_t id = 0; id < grid.size(); ++id) ids[id] = id;
+  return ids;
+}
+
+// The flight's slope: its normal leans back from +x, rise over going.
+Eigen::Vector3f rampNormal() { return Eigen::Vector3f(-kRise, 0.0F, kGoing).normalized(); }
+
+// Step k's band as the cut leaves it: 4 m wide along y, from the riser's foot to its
+// nosing (`height` m), leaning back 40° from plumb.
+Plane band(int k, double height) {
+  Plane plane;
+  const double lean = 40.0 * std::numbers::pi / 180.0;
+  plane.normal = Eigen::Vector3d(std::cos(lean), 0.0, -std::sin(lean));
+  const Eigen::Vector3d foot(riserX(k), 0.0, k * kRise);
+  const Eigen::Vector3d up_band = Eigen::Vector3d(std::sin(lean), 0.0, std::cos(lean)) * (height / std::cos(lean));
+  plane.offset = -plane.normal.dot(foot);
+  plane.outline = {foot + Eigen::Vector3d(0.0, -2.0, 0.0), foot + Eigen::Vector3d(0.0, 2.0, 0.0),
+                   foot + up_band + Eigen::Vector3d(0.0, 2.0, 0.0), foot + up_band + Eigen::Vector3d(0.0, -2.0, 0.0)};
+  plane.centroid = foot + 0.5 * up_band;
+  plane.area = 4.0 * up_band.norm();
+  return plane;
+}
+
+}  // namespace
+
+TEST_CASE("Planes on stairs seen from below: bands a riser apart, three or more, are steps") {
+  std::vector<Plane> flight;
+  for (int k = 0; k < 4; ++k) flight.push_back(band(k, 0.14));
+  std::vector<Plane> two(flight.begin(), flight.begin() + 2);
+  std::vector<Plane> tall{band(0, 1.0), band(3, 1.0), band(6, 1.0)};  // no step's band: a metre tall
+  classifyPlanes(flight);
+  classifyPlanes(two);
+  classifyPlanes(tall);
+  for (const Plane& plane : flight) CHECK(plane.label == PlaneClass::Step);  // 'other' before
+  for (const Plane& plane : two) CHECK(plane.label == PlaneClass::Other);
+  for (const Plane& plane : tall) CHECK(plane.label == PlaneClass::Other);
+}
+
+TEST_CASE("Planes on stairs seen from below: a ramp through the risers is cut into one patch per riser") {
+  for (const double cell : {0.05, 0.1}) {
+    for (const unsigned seed : {1U, 2U}) {
+      CAPTURE(cell);
+      CAPTURE(seed);
+      test::PlaneSceneBuilder scene = risersFromBelow(cell, seed);
+      const BlockGrid grid(scene.map());
+      PatchSet set;
+      set.labels.assign(grid.size(), 0);
+      test::addPatch(grid, set, allBlocks(grid), rampNormal(), kKappa, kNoise);
+      REQUIRE(set.planes.size() == 1);
+      const StepConfig config{kNoise, 6, 0.15};
+      CHECK(splitSteps(grid, set, config) == 1);
+      // Per riser, the patch holding most of its blocks holds them all and no other riser's.
+      std::vector<std::set<std::int32_t>> patches_of(kRisers);
+      std::vector<std::set<int>> risers_of(set.planes.size() + 1);
+      for (std::uint32_t id = 0; id < grid.size(); ++id) {
+        const int k = riserOf(grid, id);
+        REQUIRE(k >= 0);
+        patches_of[static_cast<std::size_t>(k)].insert(set.labels[id]);
+        if (set.labels[id] > 0) risers_of[static_cast<std::size_t>(set.labels[id])].insert(k);
+      }
+      CHECK(set.planes.size() == kRisers);
+      for (int k = 0; k < kRisers; ++k) {
+        CAPTURE(k);
+        const std::set<std::int32_t>& on = patches_of[static_cast<std::size_t>(k)];
+        CHECK(on.size() == 1);
+        CHECK(*on.begin() > 0);
+        if (*on.begin() > 0) CHECK(risers_of[static_cast<std::size_t>(*on.begin())].size() == 1);
+      }
+      // Each step's plane is the riser's own: plumb within 10°, at its x within 2 cm.
+      for (const Plane& plane : set.planes) {
+        CAPTURE(plane.centroid.transpose());
+        CHECK(std::abs(plane.normal.z()) < std::sin(10.0 * std::numbers::pi / 180.0));
+        const int k = static_cast<int>(std::lround((plane.centroid.x() - kFirst) / kGoing));
+        CHECK(std::abs(plane.centroid.x() - riserX(k)) < 0.02);
+      }
+    }
+  }
+}
+
+TEST_CASE("Planes on stairs seen from below: a real ramp's patch stays whole") {
+  // A ramp 3 m long at the flight's slope (29.7°), sampled every 2 cm with the same noise:
+  // its blocks spread along its normal by the noise, so it is no staircase.
+  for (const double cell : {0.05, 0.1}) {
+    CAPTURE(cell);
+    test::PlaneSceneBuilder scene(cell, kNoise, 3);
+    const Eigen::Vector3d up_the_ramp = Eigen::Vector3d(kGoing, 0.0, kRise).normalized() * 3.0;
+    scene.withNoise(kNoise, kNoise * kNoise).rectangle({0.07, -1.5, 0.0}, up_the_ramp, {0.0, 3.0, 0.0}, 0.02);
+    const BlockGrid grid(scene.map());
+    PatchSet set;
+    set.labels.assign(grid.size(), 0);
+    test::addPatch(grid, set, allBlocks(grid), rampNormal(), kKappa, kNoise);
+    CHECK(splitSteps(grid, set, StepConfig{kNoise, 6, 0.15}) == 0);
+    REQUIRE(set.planes.size() == 1);
+    CHECK(set.blocks.front().size() == grid.size());
+  }
+}
