@@ -8,6 +8,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <random>
 #include <set>
@@ -137,6 +138,44 @@ TEST_CASE("Planes on stairs seen from below: a ramp through the risers is cut in
         const int k = static_cast<int>(std::lround((plane.centroid.x() - kFirst) / kGoing));
         CHECK(std::abs(plane.centroid.x() - riserX(k)) < 0.02);
       }
+    }
+  }
+}
+
+TEST_CASE("Planes on stairs seen from below: a ramp over part of the flight's width leaves whole risers") {
+  // At 5 cm cells fr079's ramps were pieces a metre or two wide of a flight 5 m wide: each
+  // step grows along its band over the blocks of no patch, not into the next step's.
+  for (const double cell : {0.05, 0.1}) {
+    CAPTURE(cell);
+    test::PlaneSceneBuilder scene = risersFromBelow(cell, 3);
+    const BlockGrid grid(scene.map());
+    std::vector<std::uint32_t> half;
+    for (std::uint32_t id = 0; id < grid.size(); ++id) {
+      if (grid.pointsFrameOf(id).y() < 0.0) half.push_back(id);
+    }
+    PatchSet set;
+    set.labels.assign(grid.size(), 0);
+    test::addPatch(grid, set, half, rampNormal(), kKappa, kNoise);
+    CHECK(splitSteps(grid, set, StepConfig{kNoise, 6, 0.15}) == 1);
+    CHECK(set.planes.size() == kRisers);
+    // Per riser, its blocks on each patch (0: none).
+    std::vector<std::map<std::int32_t, int>> on(kRisers);
+    for (std::uint32_t id = 0; id < grid.size(); ++id) ++on[static_cast<std::size_t>(riserOf(grid, id))][set.labels[id]];
+    std::set<std::int32_t> taken;
+    for (int k = 0; k < kRisers; ++k) {
+      CAPTURE(k);
+      int blocks = 0;
+      int largest = 0;
+      std::int32_t id = 0;
+      for (const auto& [patch, count] : on[static_cast<std::size_t>(k)]) {
+        blocks += count;
+        if (patch > 0 && count > largest) largest = count, id = patch;
+      }
+      // Nearly all of the riser, its far half too (on no patch before the growth; a
+      // block of a point in its noise's tail beyond 3 σ stays off), on a patch of its own.
+      CHECK(largest >= 0.95 * blocks);
+      CHECK(on[static_cast<std::size_t>(k)].size() <= 2);
+      CHECK(taken.insert(id).second);
     }
   }
 }
