@@ -180,6 +180,44 @@ TEST_CASE("Planes on stairs seen from below: a ramp over part of the flight's wi
   }
 }
 
+TEST_CASE("Planes on stairs seen from above: a ramp through the treads is cut into one level patch per tread") {
+  // A scanner above the flight sees its treads, level and touching along the fall line
+  // (no valley of points between them), and its risers between: the cut at the treads'
+  // heights, each tread's riser blocks back to no patch. A generated stairwell seen from a
+  // laser 0.3 m high at 10 cm cells (its first two treads and risers) was one 26° patch.
+  constexpr int kTreads = 6;
+  for (const double cell : {0.05, 0.1}) {
+    CAPTURE(cell);
+    test::PlaneSceneBuilder scene(cell, 0.003, 4);
+    scene.withNoise(0.003, 1e-5);
+    for (int k = 0; k < kTreads; ++k) {
+      const double x = 0.07 + k * kGoing;
+      scene.rectangle({x, -1.5, k * kRise}, {0.0, 3.0, 0.0}, {0.0, 0.0, kRise}, 0.02);            // riser
+      scene.rectangle({x, -1.5, (k + 1) * kRise}, {kGoing, 0.0, 0.0}, {0.0, 3.0, 0.0}, 0.02);  // tread
+    }
+    const BlockGrid grid(scene.map());
+    PatchSet set;
+    set.labels.assign(grid.size(), 0);
+    test::addPatch(grid, set, allBlocks(grid), rampNormal(), kKappa, 0.003);
+    CHECK(splitSteps(grid, set, StepConfig{0.003, 6, 0.15}) == 1);
+    REQUIRE(set.planes.size() == kTreads);
+    std::set<int> heights;
+    for (const Plane& plane : set.planes) {
+      CAPTURE(plane.centroid.transpose());
+      CHECK(plane.normal.normalized().z() > std::cos(5.0 * std::numbers::pi / 180.0));  // level, not the ramp's 30°
+      const int k = static_cast<int>(std::lround(plane.centroid.z() / kRise)) - 1;
+      CHECK(std::abs(plane.centroid.z() - (k + 1) * kRise) < 0.01);
+      heights.insert(k);
+      // Of its 0.84 m² (the top one 0.9), most at 5 cm cells; at 10 cm the cells that hold
+      // a riser too are another surface's, and a tread keeps one or two rows of its three.
+      // None of the next tread's.
+      CHECK(plane.area > (cell < 0.07 ? 0.55 : 0.25));
+      CHECK(plane.area < 1.0);
+    }
+    CHECK(heights.size() == kTreads);
+  }
+}
+
 TEST_CASE("Planes on stairs seen from below: a real ramp's patch stays whole") {
   // A ramp 3 m long at the flight's slope (29.7°), sampled every 2 cm with the same noise:
   // its blocks spread along its normal by the noise, so it is no staircase.

@@ -46,18 +46,19 @@ struct Sample {
   std::uint32_t id = 0;
 };
 
-// The ramp's blocks in steps: cut along the fall line (`fall`, horizontal, unit) at the
-// valleys between the steps' bands. The blocks' points, binned every half `window` and
-// smoothed over a window, peak once per step (a riser's points share its position along
-// the fall line, a tread's spread over its going); two peaks are two steps where the
-// least between them is at most half the lower one. Each step's ids ascending.
+// The ramp's blocks in steps: cut along `axis` (unit: the fall line, or up) at the valleys
+// between the steps. The blocks' points, binned every half `window` along it and smoothed
+// over a window, peak once per step (along the fall line a riser's points share its
+// position; up the flight a tread's share its height); two peaks are two steps where the
+// least between them is at most half the lower one, or two empty bins. Each step's ids
+// ascending.
 std::vector<std::vector<std::uint32_t>> stepsOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
-                                                const Eigen::Vector3d& fall, double window) {
+                                                const Eigen::Vector3d& axis, double window) {
   std::vector<Sample> samples;
   samples.reserve(blocks.size());
   for (const std::uint32_t id : blocks) {
     const double points = grid.pointsOf(id).count;
-    samples.push_back({meanOf(grid, id).dot(fall), std::max(1.0, points), id});
+    samples.push_back({meanOf(grid, id).dot(axis), std::max(1.0, points), id});
   }
   std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.along < b.along; });
   const double bin = window / 2.0;
@@ -66,7 +67,12 @@ std::vector<std::vector<std::uint32_t>> stepsOf(const BlockGrid& grid, const std
   std::vector<double> weight(bins, 0.0);
   for (const Sample& sample : samples) weight[static_cast<std::size_t>((sample.along - low) / bin)] += sample.weight;
   std::vector<double> density(bins, 0.0);
+  const auto empty = [&](std::size_t b) { return b >= bins || weight[b] == 0.0; };
   for (std::size_t b = 0; b < bins; ++b) {
+    // Two empty bins in a row stay empty: smoothed, such a gap between two steps would be
+    // no valley (treads a riser apart, 3.5 bins, seen from above). A single empty bin is
+    // the spacing of the blocks' cells (half a cell: the fall line's bins).
+    if (empty(b) && ((b > 0 && empty(b - 1)) || empty(b + 1))) continue;
     density[b] = 2.0 * weight[b] + (b > 0 ? weight[b - 1] : 0.0) + (b + 1 < bins ? weight[b + 1] : 0.0);
   }
   // A valley between two steps: the density falls to at most half the step's peak and
@@ -134,6 +140,43 @@ double surfaceOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks
   return surface;
 }
 
+// Whether block `id` may be a tread's: three points or more, spread up (along z) by at most
+// 2 σ (a riser's or a wall's piece spreads up it; one or two points tell nothing).
+bool levelBlock(const BlockGrid& grid, std::uint32_t id, double noise) {
+  const BlockSpread spread = spreadAlong(grid, {id}, Eigen::Vector3d::UnitZ());
+  return spread.dof >= 2.0 && spread.rms <= kMaxSpreadOverNoise * noise;
+}
+
+// The steps of `segments` that keep a patch: as large as a patch must be and, on their own
+// plane, within 3 σ.
+struct KeptSteps {
+  std::vector<Patch> patches;
+  std::vector<Plane> planes;
+};
+KeptSteps keptSteps(const BlockGrid& grid, std::vector<std::vector<std::uint32_t>> segments,
+                    const CandidatePlane& reference, const StepConfig& config) {
+  const double cell_area = grid.cellSize() * grid.cellSize();
+  KeptSteps kept;
+  for (std::vector<std::uint32_t>& ids : segments) {
+    Patch step;
+    step.surface = surfaceOf(grid, ids);
+    step.blocks = std::move(ids);
+    if (step.blocks.size() < static_cast<std::size_t>(config.min_blocks) || step.surface * cell_area < config.min_area)
+      continue;
+    // Its own plane, turned as far as the points say (a riser seen from below leans far
+    // from the ramp): the reference only orients the normal. Fitted to all of its blocks'
+    // points: a band seen from below holds its riser and its nosing both, and leaving out
+    // those thicker than 2 σ (describePatch's rule for a second surface's points) left
+    // fr079's lower steps on planes 2-5 cm RMS from their points (1.4-2.4 cm their own).
+    Plane described = describePatch(grid, step, reference, std::numbers::pi / 2, 0.0);
+    if (spreadAlong(grid, step.blocks, described.normal.normalized()).rms > kMaxStepSpreadOverNoise * config.noise)
+      continue;
+    kept.patches.push_back(std::move(step));
+    kept.planes.push_back(std::move(described));
+  }
+  return kept;
+}
+
 }  // namespace
 
 BlockSpread spreadAlong(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal) {
@@ -155,7 +198,6 @@ std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& c
   const double tolerance = classes.horizontal_deg * std::numbers::pi / 180.0;
   const double level_cos = std::cos(tolerance);                         // tilted less: level
   const double plumb_cos = std::cos(std::numbers::pi / 2 - tolerance);  // tilted more: plumb
-  const double cell_area = grid.cellSize() * grid.cellSize();
   std::size_t cut = 0;
   const std::size_t count = set.planes.size();
   for (std::size_t k = 0; k < count; ++k) {
@@ -166,26 +208,24 @@ std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& c
     const CandidatePlane reference{ramp.normal.cast<float>(), ramp.centroid.cast<float>()};
     Eigen::Vector3d fall(normal.x(), normal.y(), 0.0);
     fall.normalize();
-    std::vector<Patch> steps;
-    std::vector<Plane> planes;
-    for (std::vector<std::uint32_t>& ids : stepsOf(grid, set.blocks[k], fall, grid.cellSize())) {
-      Patch step;
-      step.surface = surfaceOf(grid, ids);
-      step.blocks = std::move(ids);
-      if (step.blocks.size() < static_cast<std::size_t>(config.min_blocks) || step.surface * cell_area < config.min_area)
-        continue;
-      // Its own plane, turned as far as the points say (a riser seen from below leans
-      // far from the ramp): the reference only orients the normal. Fitted to all of its
-      // blocks' points: a step's blocks hold its riser and its nosing both, and leaving out
-      // those thicker than 2 σ (describePatch's rule for a second surface's points) left
-      // fr079's lower steps on planes 2-5 cm RMS from their points (1.4-2.4 cm their own).
-      Plane described = describePatch(grid, step, reference, std::numbers::pi / 2, 0.0);
-      if (spreadAlong(grid, step.blocks, described.normal.normalized()).rms > kMaxStepSpreadOverNoise * config.noise)
-        continue;
-      described.source = ramp.source;
-      described.candidates = ramp.candidates;
-      steps.push_back(std::move(step));
-      planes.push_back(std::move(described));
+    // Seen from below, a flight's steps are bands apart along its fall line; seen from
+    // above, treads at their heights, touching along it: the cut that keeps more steps.
+    KeptSteps bands = keptSteps(grid, stepsOf(grid, set.blocks[k], fall, grid.cellSize()), reference, config);
+    // The treads are the ramp's level blocks (a riser's points spread up it): cut at their
+    // heights, a riser apart at least.
+    std::vector<std::uint32_t> level_blocks = set.blocks[k];
+    std::erase_if(level_blocks, [&](std::uint32_t id) { return !levelBlock(grid, id, config.noise); });
+    KeptSteps treads =
+        level_blocks.empty()
+            ? KeptSteps{}
+            : keptSteps(grid, stepsOf(grid, level_blocks, Eigen::Vector3d::UnitZ(), classes.riser_min), reference,
+                        config);
+    KeptSteps& chosen = treads.patches.size() > bands.patches.size() ? treads : bands;
+    std::vector<Patch>& steps = chosen.patches;
+    std::vector<Plane>& planes = chosen.planes;
+    for (Plane& plane : planes) {
+      plane.source = ramp.source;
+      plane.candidates = ramp.candidates;
     }
     // One step is no staircase: a single riser whose patch took the tread's edge above it
     // (the simulated lab's and corridor's first risers at 10 cm cells) stays as it was.

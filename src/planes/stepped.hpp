@@ -19,9 +19,11 @@ struct StepConfig {
 // Each patch tilted between the classes' level and plumb tolerances
 // (ClassifyConfig::horizontal_deg: a ramp is neither floor nor wall) whose blocks' points
 // spread along its normal, pooled over its blocks, by more than twice σ (the limit
-// describePatch sets for a block holding one surface) is a staircase. It is cut into its
-// steps along its fall line, where its blocks' points thin out between two steps' bands
-// (a window of a cell: a riser's points share one position along the fall line). A step
+// describePatch sets for a block holding one surface) is a staircase, and is cut into its
+// steps where its blocks' points thin out: along its fall line between the bands a flight
+// seen from below shows (risers and nosings; a window of a cell), or, where that keeps
+// fewer steps, up the flight between the heights of its treads seen from above (its
+// level blocks, a window of a riser, ClassifyConfig::riser_min). A step
 // keeps its own patch, on its own plane, where it is as large as a patch must be and about
 // as flat (its own spread within 3 σ: a step's band is an edge, its riser and nosing). With
 // two such steps or more the ramp is cut: its other blocks go back to no patch, the first
