@@ -14,7 +14,9 @@
 #include <set>
 #include <vector>
 
+#include "../src/planes/patch_rules.hpp"
 #include "../src/planes/stepped.hpp"
+#include "mlmap/planes/ermsm.hpp"
 #include "mlmap/planes/block_grid.hpp"
 #include "mlmap/planes/classify.hpp"
 #include "patch_pieces.hpp"
@@ -34,16 +36,16 @@ constexpr double kKappa = 25.0 * std::numbers::pi / 180.0;
 
 double riserX(int k) { return kFirst + k * kGoing; }
 
-// Each riser seen as five scan lines 3 cm apart, a point every 6-10 cm along y, 8 mm of
-// range noise (along x).
-test::PlaneSceneBuilder risersFromBelow(double cell, unsigned seed) {
+// Each riser seen as `lines` scan lines `spacing` apart from 2 cm above its foot, a point
+// every 6-10 cm along y, 8 mm of range noise (along x).
+test::PlaneSceneBuilder risersFromBelow(double cell, unsigned seed, int lines = 5, double spacing = 0.03) {
   test::PlaneSceneBuilder scene(cell, kNoise, seed);
   std::mt19937 random(seed);
   std::normal_distribution<double> noise(0.0, kNoise);
   std::uniform_real_distribution<double> gap(0.06, 0.10);
   for (int k = 0; k < kRisers; ++k) {
-    for (int line = 0; line < 5; ++line) {
-      const double z = k * kRise + 0.02 + line * 0.03;
+    for (int line = 0; line < lines; ++line) {
+      const double z = k * kRise + 0.02 + line * spacing;
       for (double y = -kWidth / 2 + gap(random) / 2; y < kWidth / 2; y += gap(random)) {
         scene.map().insert(Point{riserX(k) + noise(random), y, z}, kNoise * kNoise);
       }
@@ -177,6 +179,24 @@ TEST_CASE("Planes on stairs seen from below: a ramp over part of the flight's wi
       CHECK(on[static_cast<std::size_t>(k)].size() <= 2);
       CHECK(taken.insert(id).second);
     }
+  }
+}
+
+TEST_CASE("Planes on stairs seen from below: a riser 0.14 m tall is no thin sliver at 10 cm cells") {
+  // A wall face's height is its points' own, not a count of cells: the width rule (0.7 of
+  // a cell) made a riser's strip, its blocks' tops and bottoms 7 cm either side of their
+  // middle, a line of clutter at 10 cm cells, so no riser was ever a patch there. Up a wall
+  // the least is now a riser's of 8 cm (ClassifyConfig::riser_min); a 3 cm strip stays thin.
+  for (const double height : {0.14, 0.03}) {
+    CAPTURE(height);
+    test::PlaneSceneBuilder scene(0.1, 0.003, 6);
+    scene.withNoise(0.003, 1e-5).rectangle({0.07, -1.5, 0.3}, {0.0, 3.0, 0.0}, {0.0, 0.0, height}, 0.01);
+    const BlockGrid grid(scene.map());
+    Patch patch;
+    patch.blocks = allBlocks(grid);
+    for (const std::uint32_t id : patch.blocks) patch.surface += grid.blocks()[id].surface;
+    const CandidatePlane plane{Eigen::Vector3f::UnitX(), Eigen::Vector3f(0.07F, 0.0F, 0.37F)};
+    CHECK(isThin(grid, patch, plane, 0.7 * 0.1) == (height < 0.08));  // the riser was thin before
   }
 }
 

@@ -1,5 +1,7 @@
 #include "patch_rules.hpp"
 
+#include "mlmap/planes/classify.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -162,6 +164,20 @@ bool isThin(const BlockGrid& grid, const Patch& patch, const CandidatePlane& pla
   Eigen::Matrix<double, 3, 2> basis;
   basis << u_axis, v_axis;
   const Eigen::Matrix2d in_plane = basis.transpose() * pca.covariance() * basis;
+  const ClassifyConfig classes;
+  if (std::abs(plane.normal.z()) < std::sin(classes.horizontal_deg * std::numbers::pi / 180.0)) {
+    // A wall's face: one cell wide along the wall it is a fringe or a line of clutter, but
+    // its height is its points' own, not a count of cells. Here a block counts its top and
+    // bottom, half its depth either side: a riser of 14-17 cm spreads 7-8.5 cm, about 0.7
+    // of a 10 cm cell, and the width rule refused risers at 10 cm cells (the simulated
+    // corridor's) and at 5 cm where a riser shows only 5-9 cm of itself (the far risers of a
+    // stairwell seen from 0.3 m). Up a wall the least is now the lowest riser's
+    // (ClassifyConfig::riser_min, 8 cm) with its points spread evenly up it, 8 / √12 =
+    // 2.3 cm: a face of one block 4.6 cm deep or more.
+    const double along = std::sqrt(std::max(0.0, in_plane(0, 0)));
+    const double up = std::sqrt(std::max(0.0, in_plane(1, 1)));
+    return along < min_width || up < classes.riser_min / std::sqrt(12.0);
+  }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(in_plane);
   const double minor = std::sqrt(std::max(0.0, solver.eigenvalues()(0)));
   return minor < min_width;

@@ -67,7 +67,8 @@ std::size_t fitPoints(const BlockGrid& grid, const Patch& patch);
 
 // A patch one cell wide is no surface: it is the fringe of a wall standing on a cell
 // boundary (stray points in the next column) or a line of clutter. True when its blocks
-// spread across the plane less than `min_width` (m, standard deviation) in some direction.
+// spread across the plane less than `min_width` (m, standard deviation) in some direction;
+// for a plumb patch, along the wall by `min_width` and up it by a riser's (8 cm) points.
 bool isThin(const BlockGrid& grid, const Patch& patch, const CandidatePlane& plane, double min_width,
             int threads = 1);
 
