@@ -192,47 +192,54 @@ BlockSpread spreadAlong(const BlockGrid& grid, const std::vector<std::uint32_t>&
   return spread;
 }
 
-std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& config) {
-  if (!(config.noise > 0.0)) return 0;
+std::vector<StepPiece> staircaseSteps(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
+                                      const Eigen::Vector3d& normal_in, const Eigen::Vector3d& point,
+                                      const StepConfig& config) {
+  if (!(config.noise > 0.0) || blocks.empty()) return {};
   const ClassifyConfig classes;
   const double tolerance = classes.horizontal_deg * std::numbers::pi / 180.0;
-  const double level_cos = std::cos(tolerance);                         // tilted less: level
-  const double plumb_cos = std::cos(std::numbers::pi / 2 - tolerance);  // tilted more: plumb
+  const Eigen::Vector3d normal = normal_in.normalized();
+  const double up = std::abs(normal.z());
+  // Tilted less: level; more: plumb.
+  if (up >= std::cos(tolerance) || up <= std::cos(std::numbers::pi / 2 - tolerance)) return {};
+  if (!isStepped(grid, blocks, normal, config.noise)) return {};
+  const CandidatePlane reference{normal.cast<float>(), point.cast<float>()};
+  Eigen::Vector3d fall(normal.x(), normal.y(), 0.0);
+  fall.normalize();
+  // Seen from below, a flight's steps are bands apart along its fall line; seen from
+  // above, treads at their heights, touching along it: the cut that keeps more steps.
+  KeptSteps bands = keptSteps(grid, stepsOf(grid, blocks, fall, grid.cellSize()), reference, config);
+  // The treads are the ramp's level blocks (a riser's points spread up it): cut at their
+  // heights, a riser apart at least.
+  std::vector<std::uint32_t> level_blocks = blocks;
+  std::erase_if(level_blocks, [&](std::uint32_t id) { return !levelBlock(grid, id, config.noise); });
+  KeptSteps treads =
+      level_blocks.empty()
+          ? KeptSteps{}
+          : keptSteps(grid, stepsOf(grid, level_blocks, Eigen::Vector3d::UnitZ(), classes.riser_min), reference, config);
+  KeptSteps& chosen = treads.patches.size() > bands.patches.size() ? treads : bands;
+  // One step is no staircase: a single riser whose patch took the tread's edge above it
+  // (the simulated lab's and corridor's first risers at 10 cm cells) stays as it was.
+  std::vector<StepPiece> pieces;
+  if (chosen.patches.size() < 2) return pieces;
+  for (std::size_t n = 0; n < chosen.patches.size(); ++n) {
+    pieces.push_back({std::move(chosen.patches[n].blocks), chosen.patches[n].surface, std::move(chosen.planes[n])});
+  }
+  return pieces;
+}
+
+std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& config) {
   std::size_t cut = 0;
   const std::size_t count = set.planes.size();
   for (std::size_t k = 0; k < count; ++k) {
     const Plane ramp = set.planes[k];
-    const Eigen::Vector3d normal = ramp.normal.normalized();
-    const double up = std::abs(normal.z());
-    if (up >= level_cos || up <= plumb_cos || !isStepped(grid, set.blocks[k], normal, config.noise)) continue;
-    const CandidatePlane reference{ramp.normal.cast<float>(), ramp.centroid.cast<float>()};
-    Eigen::Vector3d fall(normal.x(), normal.y(), 0.0);
+    std::vector<StepPiece> pieces = staircaseSteps(grid, set.blocks[k], ramp.normal, ramp.centroid, config);
+    if (pieces.empty()) continue;
+    Eigen::Vector3d fall(ramp.normal.x(), ramp.normal.y(), 0.0);
     fall.normalize();
-    // Seen from below, a flight's steps are bands apart along its fall line; seen from
-    // above, treads at their heights, touching along it: the cut that keeps more steps.
-    KeptSteps bands = keptSteps(grid, stepsOf(grid, set.blocks[k], fall, grid.cellSize()), reference, config);
-    // The treads are the ramp's level blocks (a riser's points spread up it): cut at their
-    // heights, a riser apart at least.
-    std::vector<std::uint32_t> level_blocks = set.blocks[k];
-    std::erase_if(level_blocks, [&](std::uint32_t id) { return !levelBlock(grid, id, config.noise); });
-    KeptSteps treads =
-        level_blocks.empty()
-            ? KeptSteps{}
-            : keptSteps(grid, stepsOf(grid, level_blocks, Eigen::Vector3d::UnitZ(), classes.riser_min), reference,
-                        config);
-    KeptSteps& chosen = treads.patches.size() > bands.patches.size() ? treads : bands;
-    std::vector<Patch>& steps = chosen.patches;
-    std::vector<Plane>& planes = chosen.planes;
-    for (Plane& plane : planes) {
-      plane.source = ramp.source;
-      plane.candidates = ramp.candidates;
-    }
-    // One step is no staircase: a single riser whose patch took the tread's edge above it
-    // (the simulated lab's and corridor's first risers at 10 cm cells) stays as it was.
-    if (steps.size() < 2) continue;
     ++cut;
     for (const std::uint32_t id : set.blocks[k]) set.labels[id] = 0;  // those on no step stay so
-    for (std::size_t n = 0; n < steps.size(); ++n) {
+    for (std::size_t n = 0; n < pieces.size(); ++n) {
       std::size_t slot = k;
       if (n > 0) {
         slot = set.planes.size();
@@ -241,17 +248,20 @@ std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& c
         set.outline_frames.emplace_back();
         set.outline_runs.emplace_back();
       }
-      planes[n].id = static_cast<std::int32_t>(slot + 1);
-      for (const std::uint32_t id : steps[n].blocks) set.labels[id] = planes[n].id;
-      set.outline_frames[slot] = OutlineFrame{planes[n].normal, planes[n].centroid, true};
+      Plane& plane = pieces[n].plane;
+      plane.id = static_cast<std::int32_t>(slot + 1);
+      plane.source = ramp.source;
+      plane.candidates = ramp.candidates;
+      for (const std::uint32_t id : pieces[n].blocks) set.labels[id] = plane.id;
+      set.outline_frames[slot] = OutlineFrame{plane.normal, plane.centroid, true};
       set.outline_runs[slot] = {};
-      set.planes[slot] = std::move(planes[n]);
-      set.blocks[slot] = std::move(steps[n].blocks);
+      set.planes[slot] = std::move(plane);
+      set.blocks[slot] = std::move(pieces[n].blocks);
     }
     // Then each step along its band, over blocks the ramp did not reach: within the slab a
     // step's points keep (3 σ) and across a gap of a cell (scan lines sparser than cells).
-    for (std::size_t n = 0; n < steps.size(); ++n) {
-      const std::size_t slot = n == 0 ? k : set.planes.size() - steps.size() + n;
+    for (std::size_t n = 0; n < pieces.size(); ++n) {
+      const std::size_t slot = n == 0 ? k : set.planes.size() - pieces.size() + n;
       Plane& step = set.planes[slot];
       if (!growStep(grid, set.labels, set.blocks[slot], step, fall, 2, kMaxStepSpreadOverNoise * config.noise))
         continue;

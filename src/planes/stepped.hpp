@@ -32,6 +32,19 @@ struct StepConfig {
 // point moments. Returns the number of ramps cut.
 std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& config);
 
+// A staircase's step: its blocks (ascending), their surface (surface units) and its plane
+// (describePatch's, on all of its blocks' points; id, source and candidates unset).
+struct StepPiece {
+  std::vector<std::uint32_t> blocks;
+  double surface = 0.0;
+  Plane plane;
+};
+// The steps splitSteps cuts the blocks `blocks` of a plane (`normal`, through `point`)
+// into, where they are a staircase and two steps or more keep a patch; else none.
+std::vector<StepPiece> staircaseSteps(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
+                                      const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
+                                      const StepConfig& config);
+
 // The blocks' points' spread along `normal` (unit), m: the root of their scatter along it
 // pooled over the blocks (each block's about its own mean), and the degrees of freedom it
 // rests on (points less one per block of two points or more).
