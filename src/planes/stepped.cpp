@@ -63,7 +63,12 @@ std::vector<std::vector<std::uint32_t>> stepsOf(const BlockGrid& grid, const std
   std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.along < b.along; });
   const double bin = window / 2.0;
   const double low = samples.front().along;
-  const auto bins = static_cast<std::size_t>((samples.back().along - low) / bin) + 1;
+  const double span = (samples.back().along - low) / bin;
+  // A flight of stairs spans metres; a patch a bin per block's width further (or no
+  // finite span at all) is no staircase to cut: one step.
+  std::vector<std::vector<std::uint32_t>> whole(1, blocks);
+  if (!(span < 4.0 * static_cast<double>(samples.size()) + 16.0)) return whole;
+  const auto bins = static_cast<std::size_t>(span) + 1;
   std::vector<double> weight(bins, 0.0);
   for (const Sample& sample : samples) weight[static_cast<std::size_t>((sample.along - low) / bin)] += sample.weight;
   std::vector<double> density(bins, 0.0);
