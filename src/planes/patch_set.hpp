@@ -37,8 +37,10 @@ struct PatchSet {
 // A Plane for the patch: refitted on its own blocks (two tables at slightly different
 // heights keep their own offsets) unless that fit is ill-defined or leaves `reference`
 // by more than κ; area, RMS, the outline moved onto the patch's own plane. Where the map
-// keeps the blocks' points, the plane and RMS are their own, without the blocks thicker
-// than 2 `noise` (σ, m; 0: all blocks) along it: those hold a second surface's points.
+// keeps the blocks' points, the plane and RMS are their own, without the blocks whose
+// points' mean lies more than 3 `noise` (σ, m; 0: all blocks) off the blocks' plane: those
+// hold mostly a second surface's points. (Leaving out the blocks thicker than 2 σ along
+// it instead was tried in session 37: docs/figures/planes.md.)
 Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad,
                     double noise);
 

@@ -18,8 +18,8 @@ struct StepConfig {
 
 // Each patch tilted between the classes' level and plumb tolerances
 // (ClassifyConfig::horizontal_deg: a ramp is neither floor nor wall) whose blocks' points
-// spread along its normal, pooled over its blocks, by more than twice σ (the limit
-// describePatch sets for a block holding one surface) is a staircase, and is cut into its
+// spread along its normal, pooled over its blocks, by more than twice σ (a flat surface's
+// blocks spread by σ) is a staircase, and is cut into its
 // steps where its blocks' points thin out: along its fall line between the bands a flight
 // seen from below shows (risers and nosings; a window of a cell), or, where that keeps
 // fewer steps, up the flight between the heights of its treads seen from above (its
