@@ -69,11 +69,8 @@ int runPlanes(const PlanesArguments& arguments, bool quiet) {
   }
   // Classes are heights above the floor: say when there is none to measure from (a cloud
   // cut above its floor), rather than leave a user to wonder why no table is a table.
-  // Level as classification reads it (ClassifyConfig::horizontal_deg).
-  const double level_cosine = std::cos(ClassifyConfig{}.horizontal_deg * std::numbers::pi / 180.0);
-  const bool level = std::any_of(detection.planes.begin(), detection.planes.end(), [level_cosine](const Plane& plane) {
-    return std::abs(plane.normal.z()) >= level_cosine;
-  });
+  const bool level = std::any_of(detection.planes.begin(), detection.planes.end(),
+                                 [](const Plane& plane) { return isLevel(plane.normal); });
   const bool floor = std::any_of(detection.planes.begin(), detection.planes.end(),
                                  [](const Plane& plane) { return plane.label == PlaneClass::Floor; });
   if (!quiet && level && !floor) {

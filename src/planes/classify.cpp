@@ -88,13 +88,11 @@ std::string_view className(PlaneClass plane_class) {
 }
 
 void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, std::span<const SurfaceSample> surface) {
-  const double cos_horizontal = std::cos(config.horizontal_deg * std::numbers::pi / 180.0);
-  const double sin_vertical = std::sin(config.horizontal_deg * std::numbers::pi / 180.0);
   std::vector<std::size_t> horizontal;
   std::vector<Extent> extents;
   for (std::size_t k = 0; k < planes.size(); ++k) {
     extents.push_back(extentOf(planes[k]));
-    if (std::abs(planes[k].normal.z()) >= cos_horizontal) horizontal.push_back(k);
+    if (isLevel(planes[k].normal, config)) horizontal.push_back(k);
   }
   // The floor: the largest horizontal patch among the lowest ones; the ceiling: the
   // largest one a storey above it. Heights are taken from the floor's plane, not as z:
@@ -215,8 +213,7 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   // ramp through them into these bands).
   std::vector<std::size_t> bands;
   for (std::size_t k = 0; k < planes.size(); ++k) {
-    const double up = std::abs(planes[k].normal.z());
-    if (up < cos_horizontal && up > sin_vertical &&
+    if (!isLevel(planes[k].normal, config) && !isPlumb(planes[k].normal, config) &&
         extents[k].max.z() - extents[k].min.z() <= config.riser_max + config.level_tolerance)
       bands.push_back(k);
   }
@@ -240,8 +237,8 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   }
   for (std::size_t k = 0; k < planes.size(); ++k) {
     Plane& plane = planes[k];
-    if (std::abs(plane.normal.z()) >= cos_horizontal) continue;
-    if (std::abs(plane.normal.z()) > sin_vertical) {
+    if (isLevel(plane.normal, config)) continue;
+    if (!isPlumb(plane.normal, config)) {
       plane.label = in_flight[k] == 1 ? PlaneClass::Step : PlaneClass::Other;
       continue;
     }
@@ -269,7 +266,6 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
 // apart in a scan that is not quite flat) and was 'other'; room_scan2 at 10 cm: 8.75 m².
 // Labelled so before the level merge, such pieces joined the ceiling and leaned its plane.
 void labelCeilingPieces(std::vector<Plane>& planes, const ClassifyConfig& config) {
-  const double cos_horizontal = std::cos(config.horizontal_deg * std::numbers::pi / 180.0);
   const Plane* floor = nullptr;
   const Plane* ceiling = nullptr;
   for (const Plane& plane : planes) {
@@ -280,7 +276,7 @@ void labelCeilingPieces(std::vector<Plane>& planes, const ClassifyConfig& config
   // Only the other patches' labels change below: the floor and the ceiling stay as they are.
   for (Plane& plane : planes) {
     if (plane.label == PlaneClass::Floor || plane.label == PlaneClass::Ceiling) continue;
-    if (std::abs(plane.normal.z()) < cos_horizontal) continue;
+    if (!isLevel(plane.normal, config)) continue;
     if (floor->normal.dot(plane.centroid) + floor->offset >= config.ceiling_min_height &&
         std::abs(ceiling->normal.dot(plane.centroid) + ceiling->offset) < config.riser_max) {
       plane.label = PlaneClass::Ceiling;

@@ -194,8 +194,7 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
   // no other real scan's marked surface and no simulated scene changed at 0.6 or 1 m.
   const int touch_radius = std::max(2, static_cast<int>(std::ceil(0.3 / grid.cellSize())));
   const int door_radius = std::max(touch_radius, static_cast<int>(std::ceil(1.0 / grid.cellSize())));
-  const double sin_plumb = std::sin(ClassifyConfig{}.horizontal_deg * std::numbers::pi / 180.0);
-  const auto plumb = [&](const Plane& plane) { return std::abs(plane.normal.z()) <= sin_plumb; };
+  const auto plumb = [](const Plane& plane) { return isPlumb(plane.normal); };
   std::vector<CellBox> boxes(count);
   for (std::size_t k = 0; k < count; ++k) {
     for (const std::uint32_t id : set.blocks[k]) {

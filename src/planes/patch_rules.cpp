@@ -165,7 +165,7 @@ bool isThin(const BlockGrid& grid, const Patch& patch, const CandidatePlane& pla
   basis << u_axis, v_axis;
   const Eigen::Matrix2d in_plane = basis.transpose() * pca.covariance() * basis;
   const ClassifyConfig classes;
-  if (std::abs(plane.normal.z()) < std::sin(classes.horizontal_deg * std::numbers::pi / 180.0)) {
+  if (isPlumb(plane.normal.cast<double>(), classes)) {
     // A wall's face: one cell wide along the wall it is a fringe or a line of clutter, but
     // its height is its points' own, not a count of cells. Here a block counts its top and
     // bottom, half its depth either side: a riser of 14-17 cm spreads 7-8.5 cm, about 0.7

@@ -204,11 +204,8 @@ std::vector<StepPiece> staircaseSteps(const BlockGrid& grid, const std::vector<s
                                       const StepConfig& config) {
   if (!(config.noise > 0.0) || blocks.empty()) return {};
   const ClassifyConfig classes;
-  const double tolerance = classes.horizontal_deg * std::numbers::pi / 180.0;
   const Eigen::Vector3d normal = normal_in.normalized();
-  const double up = std::abs(normal.z());
-  // Tilted less: level; more: plumb.
-  if (up >= std::cos(tolerance) || up <= std::cos(std::numbers::pi / 2 - tolerance)) return {};
+  if (isLevel(normal, classes) || isPlumb(normal, classes)) return {};
   if (!isStepped(grid, blocks, normal, config.noise)) return {};
   const CandidatePlane reference{normal.cast<float>(), point.cast<float>()};
   Eigen::Vector3d fall(normal.x(), normal.y(), 0.0);
@@ -246,6 +243,7 @@ std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& c
     fall.normalize();
     ++cut;
     for (const std::uint32_t id : set.blocks[k]) set.labels[id] = 0;  // those on no step stay so
+    std::vector<std::size_t> slots;  // per step, its place in the set: the ramp's, then appended
     for (std::size_t n = 0; n < pieces.size(); ++n) {
       std::size_t slot = k;
       if (n > 0) {
@@ -264,11 +262,11 @@ std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& c
       set.outline_runs[slot] = {};
       set.planes[slot] = std::move(plane);
       set.blocks[slot] = std::move(pieces[n].blocks);
+      slots.push_back(slot);
     }
     // Then each step along its band, over blocks the ramp did not reach: within the slab a
     // step's points keep (3 σ) and across a gap of a cell (scan lines sparser than cells).
-    for (std::size_t n = 0; n < pieces.size(); ++n) {
-      const std::size_t slot = n == 0 ? k : set.planes.size() - pieces.size() + n;
+    for (const std::size_t slot : slots) {
       Plane& step = set.planes[slot];
       if (!growStep(grid, set.labels, set.blocks[slot], step, fall, 2, kMaxStepSpreadOverNoise * config.noise))
         continue;

@@ -2,6 +2,8 @@
 // orientation, height and neighbours (beyond the paper, whose planes carry no class).
 #pragma once
 
+#include <cmath>
+#include <numbers>
 #include <span>
 #include <vector>
 
@@ -40,6 +42,15 @@ struct SurfaceSample {
   Eigen::Vector3d point;
   double weight = 1.0;
 };
+
+// Level (floor, ceiling, table, tread) and plumb (wall, riser) as classification reads a
+// unit normal: within horizontal_deg of vertical, or of horizontal. Between the two: a ramp.
+inline bool isLevel(const Eigen::Vector3d& normal, const ClassifyConfig& config = {}) {
+  return std::abs(normal.z()) >= std::cos(config.horizontal_deg * std::numbers::pi / 180.0);
+}
+inline bool isPlumb(const Eigen::Vector3d& normal, const ClassifyConfig& config = {}) {
+  return std::abs(normal.z()) <= std::sin(config.horizontal_deg * std::numbers::pi / 180.0);
+}
 
 // Sets Plane::label for every plane. The floor is the largest horizontal patch near the
 // lowest one, unless the map's `surface` reaches below it; the ceiling the largest horizontal patch a storey above the floor.
