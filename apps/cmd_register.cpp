@@ -108,12 +108,17 @@ int runRegister(RegisterOptions options, bool quiet) {
   // pose. Say what the user can do about it.
   if (options.scan_noise <= 0.0) {
     std::size_t wide = 0;
+    std::size_t bent = 0;  // of them: walls within the expected spread, floors and ceilings not
     double widest = 0.0;
     for (const ScanReport& report : reports) {
       const registration::VerifiedIcp& r = report.result;
       if (report.index == 0 || r.verified || r.unconstrained || r.no_overlap || !(r.check.spread > r.check.sigma)) continue;
       ++wide;
       widest = std::max(widest, r.check.spread / r.check.sigma);
+      if (r.check.level.spread > r.check.upright.spread &&
+          !registration::disagreement(r.check, options.config.basin).empty()) {
+        ++bent;
+      }
     }
     if (wide > 0) {
       std::fflush(stdout);  // after the lines above it, also where both go to one pipe
@@ -124,6 +129,13 @@ int runRegister(RegisterOptions options, bool quiet) {
                    "per scan: 0.012 for PCL's room scans, 0.03 for 3DTK's) lets them verify and the pose graph "
                    "use them\n",
                    wide, reports.size(), widest, options.output.c_str());
+      if (bent > 0) {
+        std::fprintf(stderr,
+                     "register: note: in %zu of them the walls agree within the expected spread and the floors and "
+                     "ceilings do not: the scans' level surfaces bend differently (3DTK's floors lie 3-4 cm apart "
+                     "near the scanner), which no rigid pose removes\n",
+                     bent);
+      }
     }
   }
   if (!options.reference.empty()) {

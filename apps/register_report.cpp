@@ -16,18 +16,32 @@ nlohmann::json poseJson(const Pose& pose) {
   return rows;
 }
 
+// Floors, ceilings and table tops, or walls and the rest: their matched points, the share
+// of those explained and their residuals' robust spread.
+nlohmann::json surfaceFitJson(const registration::SurfaceFit& fit) {
+  return {{"matched", fit.matched},
+          {"explained_share", fit.matched > 0 ? static_cast<double>(fit.explained) / static_cast<double>(fit.matched) : 0.0},
+          {"residual_spread_m", fit.spread}};
+}
+
 }  // namespace
 
 std::string verificationSummary(const registration::VerifiedIcp& result) {
-  char text[256];
-  std::snprintf(text, sizeof text, "%s: %.0f %% explained, residual spread %.2f cm (expected %.2f cm), %d ICP run%s%s",
+  // Per kind of surface where both were matched: which of them the residuals come from.
+  char kinds[96] = "";
+  if (result.check.level.matched > 0 && result.check.upright.matched > 0) {
+    std::snprintf(kinds, sizeof kinds, "; walls %.2f, floors and ceilings %.2f", 100.0 * result.check.upright.spread,
+                  100.0 * result.check.level.spread);
+  }
+  char text[320];
+  std::snprintf(text, sizeof text, "%s: %.0f %% explained, residual spread %.2f cm (expected %.2f cm%s), %d ICP run%s%s",
                 result.verified        ? "verified"
                 : result.unconstrained ? "UNCONSTRAINED (a direction is free)"
                 : result.no_overlap    ? "NO OVERLAP"
                                        : "NOT VERIFIED",
                 100.0 * result.check.explained_share,
-                100.0 * result.check.spread, 100.0 * result.check.sigma, result.attempts, result.attempts == 1 ? "" : "s",
-                result.icp.degenerate ? ", degenerate geometry" : "");
+                100.0 * result.check.spread, 100.0 * result.check.sigma, kinds, result.attempts,
+                result.attempts == 1 ? "" : "s", result.icp.degenerate ? ", degenerate geometry" : "");
   return text;
 }
 
@@ -50,6 +64,8 @@ void writeRegisterReport(const std::string& path, const std::vector<ScanReport>&
                             {"rms_residual_m", r.icp.rms_residual},
                             {"explained_share", r.check.explained_share},
                             {"residual_spread_m", r.check.spread},
+                            {"level_surfaces", surfaceFitJson(r.check.level)},
+                            {"upright_surfaces", surfaceFitJson(r.check.upright)},
                             {"expected_residual_m", r.check.sigma},
                             {"noise_m", r.noise},
                             {"source_noise_m", r.source_noise},

@@ -76,6 +76,13 @@ TEST_CASE("CLI: the lab scene goes from simulate to build to info") {
     CHECK(scan["verified"].get<bool>());
     CHECK_FALSE(scan["levelled_on_floor"].get<bool>());
     CHECK(scan["rotation_eigenvalue_ratio"].get<double>() >= 7.5e-3);
+    // Per kind of surface: both matched, both within twice the expected residual.
+    const double expected = scan["expected_residual_m"].get<double>();
+    for (const char* kind : {"level_surfaces", "upright_surfaces"}) {
+      CAPTURE(kind);
+      CHECK(scan[kind]["matched"].get<int>() > 100);
+      CHECK(scan[kind]["residual_spread_m"].get<double>() <= 2.0 * expected);
+    }
   }
 }
 

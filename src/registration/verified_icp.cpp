@@ -82,6 +82,31 @@ double cloudRadius(const std::vector<Point>& source) {
 
 }  // namespace
 
+std::string disagreement(const Verification& check, const BasinConfig& config) {
+  const auto agrees = [&](const SurfaceFit& fit) {
+    return fit.matched >= config.min_matched && fit.spread <= config.max_spread_ratio * check.sigma;
+  };
+  const auto disagrees = [&](const SurfaceFit& fit) {
+    return fit.matched >= config.min_matched && fit.spread > config.max_spread_ratio * check.sigma;
+  };
+  char text[200];
+  if (agrees(check.upright) && disagrees(check.level)) {
+    std::snprintf(text, sizeof text,
+                  "the walls agree (spread %.2f cm) but the floors and ceilings do not (%.2f cm): level surfaces "
+                  "that bend between the scans (a tilting scanner's calibration), or floors that are not one plane",
+                  100.0 * check.upright.spread, 100.0 * check.level.spread);
+    return text;
+  }
+  if (agrees(check.level) && disagrees(check.upright)) {
+    std::snprintf(text, sizeof text,
+                  "the floors and ceilings agree (spread %.2f cm) but the walls do not (%.2f cm): a turn or a "
+                  "shift along the floor is off, or the walls moved between the scans",
+                  100.0 * check.level.spread, 100.0 * check.upright.spread);
+    return text;
+  }
+  return {};
+}
+
 double cloudNoise(const std::vector<Point>& points, double voxel_size, double min_noise) {
   return std::max(min_noise, cloudSurfaces(points, voxel_size).noise);
 }
@@ -151,13 +176,16 @@ Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMa
   check.good = check.matched >= config.min_matched &&
                static_cast<double>(check.explained) >= config.min_explained_share * static_cast<double>(check.matched) &&
                check.spread <= config.max_spread_ratio * sigma;
-  for (std::vector<double>& kind : kinds) {
-    if (kind.size() < config.min_matched) continue;
+  for (std::size_t k = 0; k < kinds.size(); ++k) {
+    std::vector<double>& kind = kinds[k];
+    if (kind.empty()) continue;
     const double bound = config.explained_sigmas * sigma;
     const auto explained = std::count_if(kind.begin(), kind.end(), [&](double r) { return r <= bound; });
     auto middle = kind.begin() + static_cast<long>(kind.size() / 2);
     std::nth_element(kind.begin(), middle, kind.end());
     const double spread = kMadToSigma * *middle;
+    (k == 0 ? check.level : check.upright) = SurfaceFit{kind.size(), static_cast<std::size_t>(explained), spread};
+    if (kind.size() < config.min_matched) continue;
     check.spread = std::max(check.spread, spread);
     check.good = check.good &&
                  static_cast<double>(explained) >= config.min_explained_share * static_cast<double>(kind.size()) &&
@@ -412,6 +440,8 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
                   out.attempts, 100.0 * out.check.explained_share, 100.0 * config.explained_sigmas * sigma,
                   100.0 * out.check.spread, 100.0 * sigma);
     out.reason = text;
+    const std::string split = disagreement(out.check, config);
+    if (!split.empty()) out.reason += "; " + split;
   }
   return out;
 }

@@ -93,6 +93,14 @@ struct BasinConfig {
   double rival_replace = 1.5;
 };
 
+// How well a pose explains one kind of surface: the matched points whose target normal is
+// within 45 deg of vertical (floors, ceilings, table tops), or the others (walls and the rest).
+struct SurfaceFit {
+  std::size_t matched = 0;    // with a neighbour (with a normal) within the verification gate
+  std::size_t explained = 0;  // ... and a residual within explained_sigmas · σ
+  double spread = 0.0;        // m, robust (MAD) spread of their residuals (0: none matched)
+};
+
 // How well a pose explains the source against the target.
 struct Verification {
   std::size_t source_points = 0;
@@ -106,6 +114,10 @@ struct Verification {
   double yaw_ratio = 0.0;         // ... of the turn about the vertical alone, translations free
   bool constrained = false;    // eigenvalue_ratio >= min_eigenvalue_ratio; alignVerified: see BasinConfig
   Eigen::Matrix3d translation_information = Eigen::Matrix3d::Zero();  // Σ n nᵀ of the explained points
+  // Per kind: two real scans whose walls agree but whose floors do not (a tilting scanner's
+  // calibration bends its floors: 3DTK's scans) are told apart from a wrong pose this way.
+  SurfaceFit level;            // floors, ceilings, table tops
+  SurfaceFit upright;          // walls and the rest
   SlideProfile profile;        // alignVerified only
   bool good = false;           // explains the overlap (share and spread); see constrained
 };
@@ -141,6 +153,11 @@ Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMa
                              double sigma, double gate, const BasinConfig& config = {});
 Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& pose,
                              double sigma, const BasinConfig& config = {});
+
+// Where one kind of surface is explained within max_spread_ratio · σ and the other is not
+// (both with min_matched points): one sentence saying which, for a "not verified" reason;
+// else empty.
+std::string disagreement(const Verification& check, const BasinConfig& config = {});
 
 // Aligns as above; `icp` sets the ICP itself (its initial_max_distance is a lower bound).
 VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& start,
