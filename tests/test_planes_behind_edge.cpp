@@ -122,6 +122,39 @@ TEST_CASE("nearerAlongBeam: a wall's point 3 sigma in front of it, seen along a 
   CHECK(choose(Eigen::Vector3d(-0.97, 0.18, 0.16).normalized()) == 2);
 }
 
+TEST_CASE("nearerAlongBeam: a point either surface could have returned goes to the larger, as at an edge") {
+  // As above: the wall x = 0 (slot 1, 100 000 points) and a cabinet's side y = 1 (slot 2,
+  // 5 000), 3 cm of range noise along their beams. A point 2 cm in front of the wall and
+  // 1.3 cm off the side's plane, seen obliquely: along its beam the wall's plane lies 2.7 cm
+  // off, the side's 2 cm, both within their range noise. The side took it (the lab with
+  // 3 cm of range noise: single floor and wall points on crates' and cabinets' patches,
+  // each such patch then touching the floor or a wall it is no part of).
+  std::vector<PointPlane> fitted(3);
+  fitted[1] = PointPlane{1, Eigen::Vector3d::UnitX(), 0.0, 0.03, 100000};
+  fitted[2] = PointPlane{2, Eigen::Vector3d::UnitY(), -1.0, 0.03, 5000};
+  const std::vector<double> along{0.0, 0.03, 0.03};
+  const Point point{0.02, 0.987, 1.0};
+  const Eigen::Vector3d beam = Eigen::Vector3d(-0.75, 0.66, 0.0).normalized();
+  const auto rank = [&](std::uint32_t slot) {
+    return std::abs(fitted[slot].normal.dot(point) + fitted[slot].offset) /
+           std::max(kMinIncidenceCosine, std::abs(fitted[slot].normal.dot(beam)));
+  };
+  const auto choose = [&]() {
+    return nearerAlongBeam(Candidate{2, rank(2), 0.0}, std::vector<Candidate>{{1, rank(1), 0.0}}, fitted, along, 2.0);
+  };
+  REQUIRE(rank(1) < along[1]);
+  REQUIRE(rank(2) < along[2]);
+  CHECK(choose() == 1);
+  // The smaller surface keeps what it could have returned.
+  fitted[1].points = 1000;
+  CHECK(choose() == 2);
+  // Beyond the wall's range noise along the beam (5 cm in front of it), the side keeps it.
+  fitted[1].points = 100000;
+  const Point farther{0.05, 0.987, 1.0};
+  const double wall_rank = std::abs(farther.x()) / std::abs(beam.x());
+  CHECK(nearerAlongBeam(Candidate{2, rank(2), 0.0}, std::vector<Candidate>{{1, wall_rank, 0.0}}, fitted, along, 2.0) == 2);
+}
+
 TEST_CASE("withinRangeNoise: a plane the beam grazes is not within its range noise however near") {
   const std::vector<double> along{0.0, 0.03, 0.06};
   // The floor, 3.5 cm off along the beam: beyond its 3 cm.

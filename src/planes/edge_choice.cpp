@@ -181,17 +181,26 @@ std::uint32_t nearerAlongBeam(const Candidate& alone, std::span<const Candidate>
                               double limit) {
   const PointPlane& patch = fitted[alone.slot];
   double best = alone.rank / along_tolerance[alone.slot];
-  if (!(best > 1.0)) return alone.slot;  // within the patch's range noise (or unknown)
+  if (std::isnan(best)) return alone.slot;  // range noise unknown
+  const bool beyond = best > 1.0;
   std::uint32_t chosen = alone.slot;
+  std::size_t chosen_points = patch.points;
   for (const Candidate& c : tail) {
     const PointPlane& surface = fitted[c.slot];
     if (std::abs(surface.normal.dot(patch.normal)) >= kEdgeCosine || surface.points <= patch.points ||
         !std::isfinite(along_tolerance[c.slot]))
       continue;
     const double units = c.rank / along_tolerance[c.slot];
-    if (units < best && units <= limit) {
-      best = units;
+    if (beyond) {
+      if (units < best && units <= limit) {
+        best = units;
+        chosen = c.slot;
+      }
+    } else if (units <= 1.0 && surface.points > chosen_points) {
+      // Both planes within their range noise along the beam: either surface could have
+      // returned the point, and as at an edge (likeliest) the larger takes it.
       chosen = c.slot;
+      chosen_points = surface.points;
     }
   }
   return chosen;

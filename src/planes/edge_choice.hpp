@@ -104,8 +104,11 @@ std::uint32_t behindEdge(std::uint32_t chosen, const Point& point, const Point* 
 // nearer in that surface's range noise: the surface's noise tail, not the patch. At a
 // cabinet's side against a wall, the wall's points 3σ in front of it, seen along the
 // side, lie on the side's plane alone (the simulated lab, 5 cm: 6 of a cabinet's, 1-3 of
-// each crate's and cabinet's faces, then touching the wall or the floor). Returns the
-// surface, else `alone`'s slot.
+// each crate's and cabinet's faces, then touching the wall or the floor). And a point
+// within its range noise of both planes along the beam (the patch's and a larger surface's
+// tail): either could have returned it, and as at an edge (likeliest) the larger takes it
+// (the lab with 3 cm of range noise: single floor and wall points on crates' and cabinets'
+// patches). Returns the surface, else `alone`'s slot.
 std::uint32_t nearerAlongBeam(const Candidate& alone, std::span<const Candidate> tail,
                               const std::vector<PointPlane>& fitted, const std::vector<double>& along_tolerance,
                               double limit);
