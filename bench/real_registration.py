@@ -12,7 +12,8 @@ mlmap is `mlmap register --report` (scan-to-map, its verification and retries, t
 graph); Open3D and PCL are the peers' point-to-plane ICP at their defaults (0.05 m voxels,
 gates 0.5 then 0.1 m), pairwise from the same starts. Per pair it prints each method's
 relative pose, the translation and rotation between each two methods' results, mlmap's
-verdict (verified, explained share, residual spread against the expected one) and the
+verdict (verified, explained share, residual spread against the expected one, and apart for
+walls and for floors and ceilings) and the
 seconds (mlmap: the whole register command, reading included; the peers: their own total,
 reading excluded). Skips with a message where ../shared/data or the peers are absent.
 
@@ -79,6 +80,15 @@ def residual_judge(source_path, target_path):
         return (distance < 0.05).mean(), 1.4826 * np.median(residual) if len(residual) else float("nan")
 
     return judge
+
+
+def kinds(scan):
+    """'; walls X, floors and ceilings Y' (cm) from a register report's per-kind figures, where present."""
+    level, upright = scan.get("level_surfaces"), scan.get("upright_surfaces")
+    if not level or not upright or not level["matched"] or not upright["matched"]:
+        return ""
+    return (f"; walls {100 * upright['residual_spread_m']:.2f}, "
+            f"floors and ceilings {100 * level['residual_spread_m']:.2f}")
 
 
 def run_peer(binary, source, target, poses, i, j):
@@ -162,8 +172,8 @@ def main():
             scan = report[j]
             verdict = ("verified" if scan["verified"] else "NOT verified") + \
                 f": {100 * scan['explained_share']:.0f} % explained, residual spread " \
-                f"{100 * scan['residual_spread_m']:.2f} cm (expected {100 * scan['expected_residual_m']:.2f}), " \
-                f"{scan['icp_runs']} ICP runs"
+                f"{100 * scan['residual_spread_m']:.2f} cm (expected {100 * scan['expected_residual_m']:.2f}" + \
+                kinds(scan) + f"), {scan['icp_runs']} ICP runs"
             start = np.linalg.inv(starts[i]) @ starts[j]
             print(f"| {i}-{j} | start | {describe(start)} | | |")
             print(f"| {i}-{j} | mlmap (scan-to-map, pose graph) | {describe(results['mlmap'])} | | {verdict} |")
