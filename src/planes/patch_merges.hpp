@@ -7,8 +7,8 @@
 namespace mlmap {
 
 // Patches of one real plane found apart (a refit that tilted a little, a wall on a
-// cell boundary) are merged when they are coplanar within ε (or the smaller is the
-// larger's noise tail: within 3.5 of the larger's RMS, half as spread), parallel within κ / 2
+// cell boundary) are merged when they are coplanar within ε (or the smaller may be the
+// larger's noise tail: within 3.5 of the larger's RMS), parallel within κ / 2
 // and touch on the grid; level ones meet at one height where they meet cell to cell, and
 // (`noise` > 0) their points lie about one plane within a sheet's step. A merged group's
 // outline is left pending; `noise` σ, m, as describePatch's. Patches of one family (the
