@@ -115,10 +115,7 @@ int runRegister(RegisterOptions options, bool quiet) {
       if (report.index == 0 || r.verified || r.unconstrained || r.no_overlap || !(r.check.spread > r.check.sigma)) continue;
       ++wide;
       widest = std::max(widest, r.check.spread / r.check.sigma);
-      if (r.check.level.spread > r.check.upright.spread &&
-          !registration::disagreement(r.check, options.config.basin).empty()) {
-        ++bent;
-      }
+      if (registration::onlyLevelDisagrees(r.check, options.config.basin)) ++bent;
     }
     if (wide > 0) {
       std::fflush(stdout);  // after the lines above it, also where both go to one pipe

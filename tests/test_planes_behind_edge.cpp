@@ -95,64 +95,67 @@ TEST_CASE("behindEdge: only a larger surface, seen from its front, that the patc
   }
 }
 
-TEST_CASE("nearerAlongBeam: a wall's point 3 sigma in front of it, seen along a cabinet's side, is the wall's") {
-  // The wall x = 0 (slot 1) and a cabinet's side y = 1 (slot 2), both with 3 cm of range
-  // noise along their beams (3 σ). A point 3.2 cm in front of the wall and 1.3 cm off the
-  // side's plane lies within the side's tolerance alone.
-  std::vector<PointPlane> fitted(3);
-  fitted[1] = PointPlane{1, Eigen::Vector3d::UnitX(), 0.0, 0.03, 100000};
-  fitted[2] = PointPlane{2, Eigen::Vector3d::UnitY(), -1.0, 0.03, 5000};
-  const std::vector<double> along{0.0, 0.03, 0.03};
-  const Point point{0.032, 0.987, 1.0};
-  const auto rank = [&](std::uint32_t slot, const Eigen::Vector3d& beam) {
+namespace {
+
+// nearerAlongBeam's scene: the wall x = 0 (slot 1, 100 000 points) and a cabinet's side
+// y = 1 (slot 2, 5 000), both with 3 cm of range noise along their beams (3 σ); a point on
+// the side's plane alone, the wall its tail candidate.
+struct WallAndSide {
+  std::vector<PointPlane> fitted = std::vector<PointPlane>(3);
+  std::vector<double> along{0.0, 0.03, 0.03};
+
+  WallAndSide() {
+    fitted[1] = PointPlane{1, Eigen::Vector3d::UnitX(), 0.0, 0.03, 100000};
+    fitted[2] = PointPlane{2, Eigen::Vector3d::UnitY(), -1.0, 0.03, 5000};
+  }
+  // The distance along `beam` from `point` to a slot's plane (as gather ranks it).
+  double rank(std::uint32_t slot, const Point& point, const Eigen::Vector3d& beam) const {
     return std::abs(fitted[slot].normal.dot(point) + fitted[slot].offset) /
            std::max(kMinIncidenceCosine, std::abs(fitted[slot].normal.dot(beam)));
-  };
-  const auto choose = [&](const Eigen::Vector3d& beam) {
-    const Candidate alone{2, rank(2, beam), 0.0};
-    const std::vector<Candidate> tail{{1, rank(1, beam), 0.0}};
+  }
+  std::uint32_t choose(const Point& point, const Eigen::Vector3d& beam) const {
+    const Candidate alone{2, rank(2, point, beam), 0.0};
+    const std::vector<Candidate> tail{{1, rank(1, point, beam), 0.0}};
     return nearerAlongBeam(alone, tail, fitted, along, 2.0);
-  };
+  }
+};
+
+}  // namespace
+
+TEST_CASE("nearerAlongBeam: a wall's point 3 sigma in front of it, seen along a cabinet's side, is the wall's") {
+  // A point 3.2 cm in front of the wall and 1.3 cm off the side's plane lies within the
+  // side's tolerance alone.
+  WallAndSide scene;
+  const Point point{0.032, 0.987, 1.0};
   // Seen nearly along the side: its plane lies 7 cm along the beam, the wall's 3.3 cm.
-  CHECK(choose(Eigen::Vector3d(-0.97, 0.18, 0.16).normalized()) == 1);
+  CHECK(scene.choose(point, Eigen::Vector3d(-0.97, 0.18, 0.16).normalized()) == 1);
   // Seen head on, the side's plane lies 1.3 cm along the beam: within its range noise.
-  CHECK(choose(Eigen::Vector3d(-0.3, 0.95, 0.0).normalized()) == 2);
+  CHECK(scene.choose(point, Eigen::Vector3d(-0.3, 0.95, 0.0).normalized()) == 2);
   // A smaller surface's tail takes nothing from a larger patch.
-  fitted[1].points = 1000;
-  CHECK(choose(Eigen::Vector3d(-0.97, 0.18, 0.16).normalized()) == 2);
+  scene.fitted[1].points = 1000;
+  CHECK(scene.choose(point, Eigen::Vector3d(-0.97, 0.18, 0.16).normalized()) == 2);
 }
 
 TEST_CASE("nearerAlongBeam: a point either surface could have returned goes to the larger, as at an edge") {
-  // As above: the wall x = 0 (slot 1, 100 000 points) and a cabinet's side y = 1 (slot 2,
-  // 5 000), 3 cm of range noise along their beams. A point 2 cm in front of the wall and
-  // 1.3 cm off the side's plane, seen obliquely: along its beam the wall's plane lies 2.7 cm
-  // off, the side's 2 cm, both within their range noise. The side took it (the lab with
-  // 3 cm of range noise: single floor and wall points on crates' and cabinets' patches,
-  // each such patch then touching the floor or a wall it is no part of).
-  std::vector<PointPlane> fitted(3);
-  fitted[1] = PointPlane{1, Eigen::Vector3d::UnitX(), 0.0, 0.03, 100000};
-  fitted[2] = PointPlane{2, Eigen::Vector3d::UnitY(), -1.0, 0.03, 5000};
-  const std::vector<double> along{0.0, 0.03, 0.03};
+  // A point 2 cm in front of the wall and 1.3 cm off the side's plane, seen obliquely:
+  // along its beam the wall's plane lies 2.7 cm off, the side's 2 cm, both within their
+  // range noise. The side took it (the lab with 3 cm of range noise: single floor and wall
+  // points on crates' and cabinets' patches, each such patch then touching the floor or a
+  // wall it is no part of).
+  WallAndSide scene;
   const Point point{0.02, 0.987, 1.0};
   const Eigen::Vector3d beam = Eigen::Vector3d(-0.75, 0.66, 0.0).normalized();
-  const auto rank = [&](std::uint32_t slot) {
-    return std::abs(fitted[slot].normal.dot(point) + fitted[slot].offset) /
-           std::max(kMinIncidenceCosine, std::abs(fitted[slot].normal.dot(beam)));
-  };
-  const auto choose = [&]() {
-    return nearerAlongBeam(Candidate{2, rank(2), 0.0}, std::vector<Candidate>{{1, rank(1), 0.0}}, fitted, along, 2.0);
-  };
-  REQUIRE(rank(1) < along[1]);
-  REQUIRE(rank(2) < along[2]);
-  CHECK(choose() == 1);
+  REQUIRE(scene.rank(1, point, beam) < scene.along[1]);
+  REQUIRE(scene.rank(2, point, beam) < scene.along[2]);
+  CHECK(scene.choose(point, beam) == 1);
   // The smaller surface keeps what it could have returned.
-  fitted[1].points = 1000;
-  CHECK(choose() == 2);
+  scene.fitted[1].points = 1000;
+  CHECK(scene.choose(point, beam) == 2);
   // Beyond the wall's range noise along the beam (5 cm in front of it), the side keeps it.
-  fitted[1].points = 100000;
+  scene.fitted[1].points = 100000;
   const Point farther{0.05, 0.987, 1.0};
-  const double wall_rank = std::abs(farther.x()) / std::abs(beam.x());
-  CHECK(nearerAlongBeam(Candidate{2, rank(2), 0.0}, std::vector<Candidate>{{1, wall_rank, 0.0}}, fitted, along, 2.0) == 2);
+  REQUIRE(scene.rank(1, farther, beam) > scene.along[1]);
+  CHECK(scene.choose(farther, beam) == 2);
 }
 
 TEST_CASE("withinRangeNoise: a plane the beam grazes is not within its range noise however near") {

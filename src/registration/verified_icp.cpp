@@ -82,22 +82,33 @@ double cloudRadius(const std::vector<Point>& source) {
 
 }  // namespace
 
+namespace {
+
+// Whether `agrees` is explained within max_spread_ratio · σ and `apart` is not, both with
+// min_matched points: one kind of surface fits, the other does not.
+bool oneKindApart(const Verification& check, const SurfaceFit& agrees, const SurfaceFit& apart,
+                  const BasinConfig& config) {
+  const double bound = config.max_spread_ratio * check.sigma;
+  return agrees.matched >= config.min_matched && apart.matched >= config.min_matched && agrees.spread <= bound &&
+         apart.spread > bound;
+}
+
+}  // namespace
+
+bool onlyLevelDisagrees(const Verification& check, const BasinConfig& config) {
+  return oneKindApart(check, check.upright, check.level, config);
+}
+
 std::string disagreement(const Verification& check, const BasinConfig& config) {
-  const auto agrees = [&](const SurfaceFit& fit) {
-    return fit.matched >= config.min_matched && fit.spread <= config.max_spread_ratio * check.sigma;
-  };
-  const auto disagrees = [&](const SurfaceFit& fit) {
-    return fit.matched >= config.min_matched && fit.spread > config.max_spread_ratio * check.sigma;
-  };
   char text[200];
-  if (agrees(check.upright) && disagrees(check.level)) {
+  if (onlyLevelDisagrees(check, config)) {
     std::snprintf(text, sizeof text,
                   "the walls agree (spread %.2f cm) but the floors and ceilings do not (%.2f cm): level surfaces "
                   "that bend between the scans (a tilting scanner's calibration), or floors that are not one plane",
                   100.0 * check.upright.spread, 100.0 * check.level.spread);
     return text;
   }
-  if (agrees(check.level) && disagrees(check.upright)) {
+  if (oneKindApart(check, check.level, check.upright, config)) {
     std::snprintf(text, sizeof text,
                   "the floors and ceilings agree (spread %.2f cm) but the walls do not (%.2f cm): a turn or a "
                   "shift along the floor is off, or the walls moved between the scans",

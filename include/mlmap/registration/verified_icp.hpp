@@ -158,6 +158,8 @@ Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMa
 // (both with min_matched points): one sentence saying which, for a "not verified" reason;
 // else empty.
 std::string disagreement(const Verification& check, const BasinConfig& config = {});
+// ... the walls within it and the floors and ceilings not (real scans whose level surfaces bend).
+bool onlyLevelDisagrees(const Verification& check, const BasinConfig& config = {});
 
 // Aligns as above; `icp` sets the ICP itself (its initial_max_distance is a lower bound).
 VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& start,
