@@ -34,6 +34,7 @@ std::optional<Eigen::Vector3d> namedAxis(const std::string& name) {
 const char* cueName(registration::UpCue cue) {
   switch (cue) {
     case registration::UpCue::Poses: return "the axis the scans turn about";
+    case registration::UpCue::Positions: return "the plane the sensors moved in";
     case registration::UpCue::Planes: return "the planes most surfaces face";
     case registration::UpCue::None: break;
   }
@@ -112,6 +113,7 @@ void ScanReading::resolveUp(const std::string& up) {
   // (44-51 % of the planar cells), and a camera's single view (office1) shows the far wall
   // as much as the floor: warnings there would be wrong.
   const bool strong = estimate.line_from == registration::UpCue::Poses ||
+                      estimate.line_from == registration::UpCue::Positions ||
                       (estimate.line_from == registration::UpCue::Planes && estimate.planar_share >= 0.5 &&
                        estimate.below_share >= 0.1 && estimate.below_share <= 0.9);
   if (std::abs(estimate.up.z()) < 0.5 && strong) {

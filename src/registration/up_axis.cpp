@@ -59,6 +59,32 @@ int turnAxis(const std::vector<Pose>& poses) {
   return summed.norm() > 0.0 ? snappedAxis(summed) : -1;
 }
 
+// The sensors moved in a plane when their positions spread across it by at least this
+// (standard deviation, m: a corridor's zig-zag of a few decimetres) and out of it by at most
+// this share of that (a robot's scanner height holds to a centimetre over metres; a hand-held
+// sensor's bobs by a tenth of its spread or more, and tells nothing).
+constexpr double kMinPlaneSpread = 0.1;
+constexpr double kMaxOutOfPlane = 0.1;
+
+// The coordinate axis normal to the plane the poses' positions lie in, or -1.
+int movedPlaneAxis(const std::vector<Pose>& poses) {
+  if (poses.size() < 3) return -1;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Pose& pose : poses) mean += pose.translation();
+  mean /= static_cast<double>(poses.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const Pose& pose : poses) {
+    const Eigen::Vector3d d = pose.translation() - mean;
+    covariance += d * d.transpose();
+  }
+  covariance /= static_cast<double>(poses.size());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  const Eigen::Vector3d values = solver.eigenvalues().cwiseMax(0.0);  // ascending
+  if (!(std::sqrt(values(1)) >= kMinPlaneSpread)) return -1;
+  if (!(std::sqrt(values(0)) <= kMaxOutOfPlane * std::sqrt(values(1)))) return -1;
+  return snappedAxis(solver.eigenvectors().col(0));
+}
+
 }  // namespace
 
 UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig& config,
@@ -108,6 +134,8 @@ UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig
   int line = turnAxis(poses);
   if (line >= 0) {
     estimate.line_from = UpCue::Poses;
+  } else if ((line = movedPlaneAxis(poses)) >= 0) {
+    estimate.line_from = UpCue::Positions;
   } else if (estimate.planar_cells >= kMinPlanarCells) {
     line = static_cast<int>(std::max_element(facing.begin(), facing.end()) - facing.begin());
     estimate.line_from = UpCue::Planes;

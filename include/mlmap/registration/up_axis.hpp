@@ -3,8 +3,10 @@
 // y-down frame turned by its VIEWPOINT, a sensor mounted on its side) maps walls as
 // floors. The up axis is found in the data, among the six signed coordinate axes:
 //  1. the line: when the scans' rotations differ, the axis they turn about (a robot
-//     turns about up only); else the axis the most planar cells face (floors and
-//     ceilings, desks and seats; walls split between two axes);
+//     turns about up only); else, when the sensors moved in a plane (a robot or a trolley
+//     carries its scanner at one height), that plane's normal; else the axis the most
+//     planar cells face (floors and ceilings, desks and seats; walls split between two
+//     axes, but a long corridor's two walls outnumber its floor and ceiling);
 //  2. the sign: of the points on that family's planes, more lie below their sensor
 //     (floor, table tops, seats: a scanner is mounted, a camera held, nearer the floor
 //     than the ceiling, and denser readings fall on the nearer surface).
@@ -18,7 +20,7 @@
 
 namespace mlmap::registration {
 
-enum class UpCue { None, Poses, Planes };
+enum class UpCue { None, Poses, Positions, Planes };
 
 struct UpAxisEstimate {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // a signed coordinate axis, world frame
