@@ -4,7 +4,8 @@
 // floors. The up axis is found in the data, among the six signed coordinate axes:
 //  1. the line: when the scans' rotations differ, the axis they turn about (a robot
 //     turns about up only); else, when the sensors moved in a plane (a robot or a trolley
-//     carries its scanner at one height), that plane's normal; else the axis the most
+//     carries its scanner at one height; a drone flying up and down a wall would mislead
+//     this), that plane's normal; else the axis the most
 //     planar cells face (floors and ceilings, desks and seats; walls split between two
 //     axes, but a long corridor's two walls outnumber its floor and ceiling);
 //  2. the sign: of the points on that family's planes, more lie below their sensor
