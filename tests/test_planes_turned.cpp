@@ -4,8 +4,6 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -112,13 +110,7 @@ TEST_CASE("Planes turned: a box room turned 7 or 10 deg gives each wall one patc
 // parallel to a wall within 3.5 times the wall's RMS now joins it where their joint fit says
 // they are one surface.
 TEST_CASE("Planes turned: the lab with 3 cm of range noise, turned 10 deg, has no plane beside a wall") {
-  std::string json;
-  {
-    std::ifstream file(std::string(MLMAP_SOURCE_DIR) + "/maps/lab.json");
-    json.assign(std::istreambuf_iterator<char>(file), {});
-  }
-  REQUIRE(!json.empty());
-  sim::Scene scene = sim::parseScene(json, std::string(MLMAP_SOURCE_DIR) + "/maps/lab.json");
+  sim::Scene scene = sim::loadScene(std::string(MLMAP_SOURCE_DIR) + "/maps/lab.json");
   scene.pattern.range_sigma = 0.03;
   sim::transformScene(scene, sim::Placement{0.0, 0.0, 10.0});
   MLMap map = test::simulatedMap(scene, 0.05);

@@ -3,8 +3,6 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <utility>
 #include <numbers>
@@ -261,25 +259,12 @@ TEST_CASE("alignVerified: the facing points' fit is taken from 2 standard errors
   // The shipped corridor with 3 cm of range noise (register_ate.py's tune split), scans 3 and 4:
   // ICP stops 4.8-5.1 mm short along the corridor, verified, and the ~280 points facing its axis
   // fit a shift of 2.4-2.5 standard errors, which the 3 they had to reach left untaken.
-  std::string json;
-  {
-    std::ifstream file(std::string(MLMAP_SOURCE_DIR) + "/maps/corridor.json");
-    json.assign(std::istreambuf_iterator<char>(file), {});
-  }
-  REQUIRE(!json.empty());
-  sim::Scene scene = sim::parseScene(json, std::string(MLMAP_SOURCE_DIR) + "/maps/corridor.json");
+  sim::Scene scene = sim::loadScene(std::string(MLMAP_SOURCE_DIR) + "/maps/corridor.json");
   scene.pattern.range_sigma = 0.03;
   scene.pattern.seed = 1;
   REQUIRE(scene.poses.size() > 4);
   scene.poses = {scene.poses[3], scene.poses[4]};
-  const auto scans = sim::simulate(scene);
-  Pair corridor;
-  std::vector<Point> world;
-  for (std::size_t i = 0; i < scans[0].scan.size(); ++i) world.push_back(scans[0].scan.worldPoint(i));
-  corridor.target.addPoints(voxelDownSample(world, 0.05));
-  corridor.target.estimateNormals({});
-  corridor.source = voxelDownSample(scans[1].scan.points, 0.1);
-  corridor.true_pose = scans[1].true_pose;
+  const Pair corridor = simulatedPair(scene);
   for (const auto& [shift, yaw] :
        {std::pair{Eigen::Vector3d(-0.11519233966553731, -0.017766036864047385, 0.0), -3.778066547444106},
         std::pair{Eigen::Vector3d(0.10459825569753579, -0.04282307621269104, 0.0), 2.757076286852902}}) {

@@ -42,10 +42,8 @@ struct Pair {
   Pose true_pose;             // source -> target (the target is in the world frame)
 };
 
-// `name`: where the scene's includes are looked up from.
-inline Pair simulatedPair(const std::string& json, const std::string& name = "scene.json",
-                          const NormalConfig& normals = {}) {
-  const mlmap::sim::Scene scene = mlmap::sim::parseScene(json, name);
+// The scene's first two poses, simulated.
+inline Pair simulatedPair(const mlmap::sim::Scene& scene, const NormalConfig& normals = {}) {
   const auto scans = mlmap::sim::simulate(scene);
   Pair pair;
   std::vector<Point> world;
@@ -55,6 +53,12 @@ inline Pair simulatedPair(const std::string& json, const std::string& name = "sc
   pair.source = voxelDownSample(scans[1].scan.points, 0.1);
   pair.true_pose = scans[1].true_pose;
   return pair;
+}
+
+// `name`: where the scene's includes are looked up from.
+inline Pair simulatedPair(const std::string& json, const std::string& name = "scene.json",
+                          const NormalConfig& normals = {}) {
+  return simulatedPair(mlmap::sim::parseScene(json, name), normals);
 }
 
 // The true pose turned by `yaw_deg` about the sensor and moved by `shift`.
