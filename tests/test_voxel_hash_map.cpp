@@ -96,6 +96,17 @@ TEST_CASE("VoxelHashMap: nearest and within match brute force on a structured cl
   checkAgainstBruteForce(cloud, 0.05, 0.3, 7, 3.0);
 }
 
+TEST_CASE("VoxelHashMap: gates of one to two voxels match brute force (own voxel and first shell first)") {
+  // Searched voxel by voxel: the query's own voxel, then only the first shell where a point
+  // within a voxel was found there, and nothing where no block meets the search's box.
+  const std::vector<Point> cloud = structuredCloud(15);
+  checkAgainstBruteForce(cloud, 0.1, 0.15, 16, 3.0);
+  checkAgainstBruteForce(cloud, 0.1, 0.2, 17, 3.0, 2);
+  const mlmap::Scan scan = mlmap::test::randomScan(600, 18, 2.0);  // sparse: many searches find nothing
+  checkAgainstBruteForce(scan.points, 0.1, 0.12, 19, 2.0);
+  checkAgainstBruteForce(scan.points, 0.1, 0.19, 20, 2.0, 3);
+}
+
 TEST_CASE("VoxelHashMap: wide gates (searched by blocks) match brute force, also after adding in parts") {
   // Gates of many voxels, as the wide ICP basin uses (up to 2 m at 0.1 m voxels): most queries
   // anywhere around the cloud then find a far point or, beyond the gate, none.

@@ -39,6 +39,40 @@ double cellGap(std::int32_t delta, double f) {
   return 0.0;
 }
 
+// Calls visit(dx, dy, dz) for the 26 neighbours of a query's voxel whose box may lie
+// within the radius (√limit_sq voxels; the visitor may shrink limit_sq) of the query at
+// `fraction` inside its voxel, in lexicographic order (the shell loop's): only the sides
+// whose face lies within the radius when they are reached. The radius only shrinks, so a
+// neighbour left out would fail a test of its box against it anyway.
+template <typename Visit>
+void visitFirstShell(const Eigen::Vector3d& fraction, const double& limit_sq, Visit&& visit) {
+  const auto sides = [&limit_sq](double f, std::int32_t (&deltas)[3]) {
+    int count = 0;
+    if (f * f <= limit_sq) deltas[count++] = -1;
+    deltas[count++] = 0;
+    if ((1.0 - f) * (1.0 - f) <= limit_sq) deltas[count++] = 1;
+    return count;
+  };
+  std::int32_t xs[3], ys[3], zs[3];
+  const int nx = sides(fraction.x(), xs), ny = sides(fraction.y(), ys), nz = sides(fraction.z(), zs);
+  for (int a = 0; a < nx; ++a)
+    for (int b = 0; b < ny; ++b)
+      for (int c = 0; c < nz; ++c) {
+        if (xs[a] == 0 && ys[b] == 0 && zs[c] == 0) continue;
+        const double gx = xs[a] < 0 ? fraction.x() : xs[a] > 0 ? 1.0 - fraction.x() : 0.0;
+        const double gy = ys[b] < 0 ? fraction.y() : ys[b] > 0 ? 1.0 - fraction.y() : 0.0;
+        const double gz = zs[c] < 0 ? fraction.z() : zs[c] > 0 ? 1.0 - fraction.z() : 0.0;
+        if (gx * gx + gy * gy + gz * gz > limit_sq) continue;
+        visit(xs[a], ys[b], zs[c]);
+      }
+}
+
+// cellGap without branches (the same values): a wide search tests some 40 voxels a query.
+double flatGap(std::int32_t delta, double f) {
+  const auto d = static_cast<double>(delta);
+  return std::max({0.0, d - f, f - 1.0 - d});
+}
+
 }  // namespace
 
 VoxelHashMap::VoxelHashMap(double voxel_size, std::size_t max_points_per_voxel)
@@ -104,6 +138,8 @@ void VoxelHashMap::indexBlocks() {
   std::vector<std::uint32_t> cursor(begin.begin(), begin.end() - 1);
   block_voxels_.resize(voxel_block_.size());
   for (std::size_t v = 0; v < voxel_block_.size(); ++v) block_voxels_[cursor[voxel_block_[v]]++] = static_cast<std::uint32_t>(v);
+  block_voxel_keys_.resize(block_voxels_.size());
+  for (std::size_t k = 0; k < block_voxels_.size(); ++k) block_voxel_keys_[k] = table_.key(block_voxels_[k]);
   block_begin_ = std::move(begin);
 }
 
@@ -133,7 +169,30 @@ void VoxelHashMap::visitVoxels(const Point& query, double radius, Visit&& visit)
   };
   const std::int32_t max_shell =
       std::max({own.x - low.x, high.x - own.x, own.y - low.y, high.y - own.y, own.z - low.z, high.z - own.z});
-  for (std::int32_t k = 0; k <= max_shell; ++k) {
+  // The query's own voxel first (shell 0). Where it is empty: 35-39 % of the ICP's
+  // searches on the stress benchmark's lab and rooms find nothing (parts of a scan the map
+  // never saw), and if no block of 4³ voxels meets the search's box, no voxel does: a few
+  // block lookups answer what up to 124 voxel positions would.
+  const std::uint32_t own_index = table_.find(own);
+  if (own_index != VoxelTable::kMissing) {
+    const double next_radius = visit(own_index);
+    limit_sq = next_radius * next_radius * inverse_size_ * inverse_size_;
+  } else if (max_shell <= kBlock) {
+    const VoxelKey first = blockOf(low), last = blockOf(high);
+    bool any = false;
+    for (std::int32_t bx = first.x; bx <= last.x && !any; ++bx)
+      for (std::int32_t by = first.y; by <= last.y && !any; ++by)
+        for (std::int32_t bz = first.z; bz <= last.z && !any; ++bz) any = blocks_.find({bx, by, bz}) != VoxelTable::kMissing;
+    if (!any) return;
+  }
+  // Where that leaves a radius of a voxel or less (the fine stage's gates, and most
+  // searches of two voxels), the rest lies among the neighbours visitFirstShell leaves,
+  // visited in the shell loop's order below.
+  if (max_shell <= 1 || limit_sq <= 1.0) {
+    if (max_shell >= 1) visitFirstShell(fraction, limit_sq, visitKey);
+    return;
+  }
+  for (std::int32_t k = 1; k <= max_shell; ++k) {
     // Every voxel of shell k is at least (k − 1) voxels away from the query.
     if (static_cast<double>(k - 1) * static_cast<double>(k - 1) > limit_sq && k > 1) break;
     for (std::int32_t dx = -k; dx <= k; ++dx) {
@@ -167,6 +226,17 @@ void VoxelHashMap::visitBlocks(const Point& query, double radius, Visit&& visit)
   if (own_voxel != VoxelTable::kMissing) {
     const double next_radius = visit(own_voxel);
     limit_sq = next_radius * next_radius * inverse_size_ * inverse_size_;
+    // A point within a voxel of the query: the rest lies among the 26 voxels round its own
+    // (some 40 voxels of the blocks the radius still overlaps would be tested otherwise).
+    if (limit_sq <= 1.0) {
+      visitFirstShell(fraction, limit_sq, [&](std::int32_t dx, std::int32_t dy, std::int32_t dz) {
+        const std::uint32_t voxel = table_.find({own.x + dx, own.y + dy, own.z + dz});
+        if (voxel == VoxelTable::kMissing) return;
+        const double radius_now = visit(voxel);
+        limit_sq = radius_now * radius_now * inverse_size_ * inverse_size_;
+      });
+      return;
+    }
   }
   const auto visitBlock = [&](std::int32_t bx, std::int32_t by, std::int32_t bz) {
     const VoxelKey key{own_block.x + bx, own_block.y + by, own_block.z + bz};
@@ -179,9 +249,9 @@ void VoxelHashMap::visitBlocks(const Point& query, double radius, Visit&& visit)
     for (std::uint32_t k = block_begin_[block]; k < block_begin_[block + 1]; ++k) {
       const std::uint32_t voxel = block_voxels_[k];
       if (voxel == own_voxel) continue;
-      const VoxelKey& at = table_.key(voxel);
-      const double vx = cellGap(at.x - own.x, fraction.x()), vy = cellGap(at.y - own.y, fraction.y()),
-                   vz = cellGap(at.z - own.z, fraction.z());
+      const VoxelKey& at = block_voxel_keys_[k];
+      const double vx = flatGap(at.x - own.x, fraction.x()), vy = flatGap(at.y - own.y, fraction.y()),
+                   vz = flatGap(at.z - own.z, fraction.z());
       if (vx * vx + vy * vy + vz * vz > limit_sq) continue;
       const double next_radius = visit(voxel);
       limit_sq = next_radius * next_radius * inverse_size_ * inverse_size_;

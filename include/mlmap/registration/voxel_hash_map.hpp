@@ -112,6 +112,9 @@ class VoxelHashMap {
   std::vector<std::uint32_t> voxel_block_;  // per voxel, its block's index
   std::vector<std::uint32_t> block_begin_{0};
   std::vector<std::uint32_t> block_voxels_;
+  // The keys of block_voxels_, packed the same way: a wide search reads a block's voxels'
+  // keys in one run instead of one table entry each.
+  std::vector<VoxelKey> block_voxel_keys_;
 };
 
 }  // namespace mlmap::registration
