@@ -111,6 +111,13 @@ void VoxelHashMap::addPoints(const std::vector<Point>& points) {
     if (counts[voxel] >= max_points_per_voxel_) continue;
     ++counts[voxel];
     accepted.emplace_back(voxel, p);
+    const std::uint32_t block = voxel_block_[voxel];
+    if (block >= block_low_.size()) {
+      block_low_.resize(block + 1, Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()));
+      block_high_.resize(block + 1, Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity()));
+    }
+    block_low_[block] = block_low_[block].cwiseMin(point);
+    block_high_[block] = block_high_[block].cwiseMax(point);
     const Eigen::Vector3d d = point - centreOf(key);
     moments_[voxel].sum += d;
     moments_[voxel].outer.noalias() += d * d.transpose();
@@ -268,6 +275,11 @@ void VoxelHashMap::visitBlocks(const Point& query, double radius, Visit&& visit)
     if (gx * gx + gy * gy + gz * gz > limit_sq) return;
     const std::uint32_t block = blocks_.find(key);
     if (block == VoxelTable::kMissing) return;
+    if (block < block_low_.size()) {  // the box of its points
+      const Eigen::Vector3d outside =
+          (block_low_[block] - query).cwiseMax(query - block_high_[block]).cwiseMax(0.0) * inverse_size_;
+      if (outside.squaredNorm() > limit_sq) return;
+    }
     for (std::uint32_t k = block_begin_[block]; k < block_begin_[block + 1]; ++k) {
       const std::uint32_t voxel = block_voxels_[k];
       if (voxel == own_voxel) continue;

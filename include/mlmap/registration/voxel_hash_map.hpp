@@ -115,6 +115,10 @@ class VoxelHashMap {
   // The keys of block_voxels_, packed the same way: a wide search reads a block's voxels'
   // keys in one run instead of one table entry each.
   std::vector<VoxelKey> block_voxel_keys_;
+  // Per block, the box of its points (m): on a surface much thinner than the block, so a
+  // wide search passes by the blocks beside it whose points lie beyond its radius.
+  std::vector<Eigen::Vector3d> block_low_;
+  std::vector<Eigen::Vector3d> block_high_;
 };
 
 }  // namespace mlmap::registration
