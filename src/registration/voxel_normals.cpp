@@ -114,7 +114,7 @@ void VoxelHashMap::estimateNormals(const NormalConfig& config) {
           const std::uint32_t block = blocks_.find({bx, by, bz});
           if (block == VoxelTable::kMissing) continue;
           for (std::uint32_t k = block_begin_[block]; k < block_begin_[block + 1]; ++k) {
-            const VoxelKey& at = table_.key(block_voxels_[k]);
+            const VoxelKey& at = block_voxel_keys_[k];
             const VoxelKey offset{at.x - key.x, at.y - key.y, at.z - key.z};
             const auto length_sq = static_cast<double>(offset.x * offset.x + offset.y * offset.y + offset.z * offset.z);
             if (length_sq <= radius * radius) found.push_back({offset, block_voxels_[k]});
