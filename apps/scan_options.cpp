@@ -91,11 +91,18 @@ void ScanReading::resolveUp(const std::string& up) {
   for (const io::StampedPose& stamped : sequence_.poses()) poses.push_back(input.world * stamped.pose);
   const registration::UpAxisEstimate estimate = registration::estimateUpAxis(first, {}, poses);
   const bool z_up = estimate.up.z() > 0.5;
-  const std::string evidence = std::string("from ") + cueName(estimate.line_from) + ": " +
-                               std::to_string(static_cast<int>(100.0 * estimate.planar_share + 0.5)) +
-                               " % of the planar cells face it, " +
-                               std::to_string(static_cast<int>(100.0 * estimate.below_share + 0.5)) +
-                               " % of their points below the sensor";
+  const std::string evidence =
+      estimate.faces_no_axis
+          ? "the " + std::to_string(estimate.planar_cells) +
+                " planar cells face no coordinate axis: the data look tilted (level a tilted sensor with "
+                "`mlmap calibrate` and --mount)"
+      : estimate.line_from == registration::UpCue::None
+          ? std::string("too few planar surfaces and no turn to tell")
+          : std::string("from ") + cueName(estimate.line_from) + ": " +
+                std::to_string(static_cast<int>(100.0 * estimate.planar_share + 0.5)) +
+                " % of the planar cells face it, " +
+                std::to_string(static_cast<int>(100.0 * estimate.below_share + 0.5)) +
+                " % of their points below the sensor";
   if (up == "auto") {
     if (!quiet_) {
       std::fprintf(stderr, "%s: up is %s (%s)%s\n", command_.c_str(), registration::axisName(estimate.up),
@@ -116,6 +123,10 @@ void ScanReading::resolveUp(const std::string& up) {
                       estimate.line_from == registration::UpCue::Positions ||
                       (estimate.line_from == registration::UpCue::Planes && estimate.planar_share >= 0.5 &&
                        estimate.below_share >= 0.1 && estimate.below_share <= 0.9);
+  if (estimate.faces_no_axis) {
+    std::fprintf(stderr, "mlmap: warning: %s; up is kept as z, which the planes' classes read\n", evidence.c_str());
+    return;
+  }
   if (std::abs(estimate.up.z()) < 0.5 && strong) {
     // "--up y", not "--up +y": the option's own spelling.
     const char* name = registration::axisName(estimate.up);

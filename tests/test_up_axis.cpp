@@ -144,3 +144,18 @@ TEST_CASE("Up axis: a long corridor's walls outnumber its floor, the plane its s
   for (std::size_t k = 0; k < bobbing.size(); ++k) bobbing[k].translation().z() = k % 3 == 0 ? 0.6 : -0.3;
   CHECK(estimateUpAxis({first}, {}, bobbing).line_from == UpCue::Planes);
 }
+
+TEST_CASE("Up axis: planes that face no coordinate axis give no line (a tilted camera is not x-up)") {
+  // PCL's table_scene_mug_stereo_textured.pcd: a stereo camera looking down at a table,
+  // whose plane lies 32 deg from every axis; `--up auto` read that as "+x (0 % of the
+  // planar cells face it)" and turned the cloud on its side. The room turned 32 deg about
+  // x and 30 deg about z: none of its surfaces faces a coordinate axis within 15 deg.
+  const Eigen::Matrix3d tilt = about(Eigen::Vector3d::UnitZ(), 30.0) * about(Eigen::Vector3d::UnitX(), 32.0);
+  const auto tilted = estimateUpAxis({turned(roomScan(), tilt)});
+  CHECK(tilted.planar_cells >= 20);
+  CHECK(tilted.line_from == UpCue::None);
+  CHECK(tilted.up.isApprox(Eigen::Vector3d::UnitZ()));
+  CHECK(tilted.planar_share == 0.0);
+  CHECK(tilted.faces_no_axis);
+  CHECK_FALSE(estimateUpAxis({turned(roomScan(), Eigen::Matrix3d::Identity())}).faces_no_axis);
+}

@@ -136,10 +136,13 @@ UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig
     estimate.line_from = UpCue::Poses;
   } else if ((line = movedPlaneAxis(poses)) >= 0) {
     estimate.line_from = UpCue::Positions;
-  } else if (estimate.planar_cells >= kMinPlanarCells) {
-    line = static_cast<int>(std::max_element(facing.begin(), facing.end()) - facing.begin());
+  } else if (const auto most = std::max_element(facing.begin(), facing.end()); *most >= kMinPlanarCells) {
+    // A family of its own: where the planar cells face no coordinate axis (a camera looking
+    // down at a table, its plane 32 deg from every axis), no axis is the line.
+    line = static_cast<int>(most - facing.begin());
     estimate.line_from = UpCue::Planes;
   } else {
+    estimate.faces_no_axis = estimate.planar_cells >= kMinPlanarCells;
     return estimate;  // no evidence: +z
   }
   const auto axis = static_cast<std::size_t>(line);

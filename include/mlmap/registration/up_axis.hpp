@@ -29,6 +29,9 @@ struct UpAxisEstimate {
   double planar_share = 0.0;      // of the planar cells, the share facing the up line
   double below_share = 0.0;       // of the points on those cells, the share below their sensor
   std::size_t planar_cells = 0;
+  // Planar cells enough to tell, but too few of them facing any coordinate axis (within
+  // 15 deg) for a line: the data are tilted (a camera looking down at a table), up stays +z.
+  bool faces_no_axis = false;
 };
 
 struct UpAxisConfig {
