@@ -76,6 +76,7 @@ struct Pass {
   std::vector<double> residuals;
   std::vector<Neighbour> matches;
   std::vector<char> missed;
+  std::vector<char> has_match;  // matches[i] holds a map point found for point i in this run
 };
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
@@ -127,6 +128,7 @@ void associateAndBuild(const std::vector<Point>& source, const VoxelHashMap& tar
   std::vector<LinearSystem> partial(blocks);
   pass.matches.resize(source.size());
   pass.missed.resize(source.size(), 0);
+  pass.has_match.resize(source.size(), 0);
   // Reuse keeps the last residual signs: a point without a match stays without one.
   std::vector<double> last = std::move(pass.residuals);
   pass.residuals.assign(source.size(), -1.0);
@@ -145,10 +147,17 @@ void associateAndBuild(const std::vector<Point>& source, const VoxelHashMap& tar
       if (search == Search::SkipMisses && pass.missed[i] != 0) continue;
       const Point moved = pose * source[i];
       if (search != Search::Reuse) {
-        const std::optional<Neighbour> neighbour = target.nearest(moved, gate);
+        // The map point last matched lies where it lay: the nearest is no farther than it now
+        // is, and a search of that radius (most often within a voxel, where the gate spans
+        // blocks) finds the same point as one of the gate.
+        double reach = gate;
+        if (pass.has_match[i] != 0) reach = std::min(gate, (moved - pass.matches[i].point).norm() * (1.0 + 1e-9));
+        std::optional<Neighbour> neighbour = target.nearest(moved, reach);
+        if (!neighbour && reach < gate) neighbour = target.nearest(moved, gate);
         pass.missed[i] = neighbour ? 0 : 1;
         if (!neighbour || (metric == IcpMetric::PointToPlane && neighbour->normal.isZero())) continue;
         pass.matches[i] = *neighbour;
+        pass.has_match[i] = 1;
       }
       pass.residuals[i] = addTerm(moved, pass.matches[i], metric, scale_sq, pivot, system);
     }
