@@ -4,7 +4,9 @@
 // sphere's bounding box overlaps, nearest first, and skips voxels farther than the best
 // point found so far; a wide search (a gate of decimetres to metres, far beyond the voxel)
 // visits blocks of 4³ voxels instead and looks only into the occupied ones, so a query that
-// finds nothing costs the blocks its sphere overlaps, not every voxel. Each voxel keeps the moments of its points, so a normal is a sum of a
+// finds nothing costs the blocks its sphere overlaps, not every voxel. A query whose own
+// voxel is empty goes by those blocks too, and one that finds a point within a voxel looks
+// only at the neighbours in reach. Each voxel keeps the moments of its points, so a normal is a sum of a
 // few neighbouring voxels' moments and one 3×3 eigen-decomposition, not a radius search.
 #pragma once
 
