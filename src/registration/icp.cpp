@@ -76,6 +76,10 @@ struct Pass {
   std::vector<double> residuals;
   std::vector<Neighbour> matches;
   std::vector<char> missed;
+  // Where a point stood and how far its search reached when it last found nothing: no map
+  // point lies within that reach of that place.
+  std::vector<Point> missed_at;
+  std::vector<double> missed_reach;
   std::vector<char> has_match;  // matches[i] holds a map point found for point i in this run
 };
 
@@ -128,6 +132,8 @@ void associateAndBuild(const std::vector<Point>& source, const VoxelHashMap& tar
   std::vector<LinearSystem> partial(blocks);
   pass.matches.resize(source.size());
   pass.missed.resize(source.size(), 0);
+  pass.missed_at.resize(source.size());
+  pass.missed_reach.resize(source.size(), 0.0);
   pass.has_match.resize(source.size(), 0);
   // Reuse keeps the last residual signs: a point without a match stays without one.
   std::vector<double> last = std::move(pass.residuals);
@@ -142,22 +148,37 @@ void associateAndBuild(const std::vector<Point>& source, const VoxelHashMap& tar
     const std::size_t begin = static_cast<std::size_t>(b) * kBlockSize;
     const std::size_t end = std::min(source.size(), begin + kBlockSize);
     const std::size_t stride_size = static_cast<std::size_t>(stride);
+    const Point* found_before = nullptr;  // the map point this block's last search found
     for (std::size_t i = (begin + stride_size - 1) / stride_size * stride_size; i < end; i += stride_size) {
       if (search == Search::Reuse && !(i < last.size() && last[i] >= 0.0)) continue;
       if (search == Search::SkipMisses && pass.missed[i] != 0) continue;
       const Point moved = pose * source[i];
       if (search != Search::Reuse) {
-        // The map point last matched lies where it lay: the nearest is no farther than it now
-        // is, and a search of that radius (most often within a voxel, where the gate spans
-        // blocks) finds the same point as one of the gate.
+        // A point that found nothing within a reach has nothing within that reach less how far
+        // it moved since: where that still covers the gate, a search would find nothing again
+        // (parts of the scan the map never saw: a third of a pass from a far start, whose
+        // searches visit the whole gate).
+        if (pass.missed[i] != 0 && pass.missed_reach[i] - (moved - pass.missed_at[i]).norm() > gate * (1.0 + 1e-9))
+          continue;
+        // Any map point bounds the distance to the nearest: a search of that radius (most
+        // often within a voxel, where the gate spans blocks) finds the same point as one of
+        // the gate. The point's own last match lies where it lay; a point without one (the
+        // fine stage's first pass after the coarse stage's sample) takes the one its
+        // predecessor in the block just found, centimetres off along the scan line.
         double reach = gate;
         if (pass.has_match[i] != 0) reach = std::min(gate, (moved - pass.matches[i].point).norm() * (1.0 + 1e-9));
+        if (found_before != nullptr) reach = std::min(reach, (moved - *found_before).norm() * (1.0 + 1e-9));
         std::optional<Neighbour> neighbour = target.nearest(moved, reach);
         if (!neighbour && reach < gate) neighbour = target.nearest(moved, gate);
         pass.missed[i] = neighbour ? 0 : 1;
+        if (!neighbour) {
+          pass.missed_at[i] = moved;
+          pass.missed_reach[i] = gate;
+        }
         if (!neighbour || (metric == IcpMetric::PointToPlane && neighbour->normal.isZero())) continue;
         pass.matches[i] = *neighbour;
         pass.has_match[i] = 1;
+        found_before = &pass.matches[i].point;
       }
       pass.residuals[i] = addTerm(moved, pass.matches[i], metric, scale_sq, pivot, system);
     }
