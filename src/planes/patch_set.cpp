@@ -198,11 +198,12 @@ Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePl
   };
   if (points.count >= 3.0) fitTo(points);
   // Then without the blocks that hold a second surface: those whose points spread along the
-  // plane's normal by more than kOneSurfaceSpread σ (a table's edge cells hold its rim and
-  // front, a ceiling's the lamps and the walls' tops), where the rest hold most of the points.
-  // Their points pulled the plane: PCL's room_scan2 desk at 10 cm cells 6.3° off its points'
-  // own fit, Bobkov's table and sideboard 1.1-2.1° and 1 cm, the room scans' ceilings 1.5-2.1
-  // cm below theirs (bench/real_data.py's RMS column).
+  // plane's normal by more than kOneSurfaceSpread σ (an edge cell holding a rim, a bevel or the
+  // face below it), where the rest hold most of the points. Their points pulled the plane:
+  // at 10 cm cells fr079's upper wall face leaned onto its lower face 8-10 cm in front and the
+  // two were one patch, ANYmal's treads lay 0.3 cm off their points' fit (bench/real_data.py,
+  // session 41). Blocks of one or two points tell nothing: PCL's room_scan2 desk at 10 cm stays
+  // 6° off, a patch of such blocks.
   if (noise > 0.0 && points.count >= 3.0) {
     PointMoments single;
     bool mixed = false;
