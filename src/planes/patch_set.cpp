@@ -126,10 +126,8 @@ double coveredArea(const BlockGrid& grid, const std::vector<std::uint32_t>& bloc
   return area;
 }
 
-// A block's points spread along its surface's normal by the noise σ; more than twice that
-// is a second surface in it (stepped.cpp's levelBlock, the same bound). Its fit is left to
-// the blocks that hold one surface where they hold at least kMinSingleShare of the points.
-constexpr double kOneSurfaceSpread = 2.0;
+// A patch's fit is left to its blocks that hold one surface (kOneSurfaceSpread) where they
+// hold at least this share of its points.
 constexpr double kMinSingleShare = 0.5;
 
 double square(double x) { return x * x; }

@@ -41,6 +41,12 @@ struct PatchSet {
 // points' mean lies more than 3 `noise` (σ, m; 0: all blocks) off the blocks' plane: those
 // hold mostly a second surface's points. (Leaving out the blocks thicker than 2 σ along
 // it instead was tried in session 37: docs/figures/planes.md.)
+// A block holding one surface spreads along its normal by the noise σ; more than this many σ
+// (pooled or per block) is a second surface in it (the riser in a ramp's blocks: 3.9 cm against
+// 1.4 cm at fr079's 10 cm cells). describePatch fits a plane without such blocks, the staircase
+// cut (stepped.hpp) tells ramps and treads by it.
+inline constexpr double kOneSurfaceSpread = 2.0;
+
 Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad,
                     double noise);
 

@@ -14,10 +14,6 @@ namespace {
 
 // Fewer points than this (beyond one per block) measure no spread: the patch stays.
 constexpr double kMinDof = 10.0;
-// A flat surface's blocks spread along its normal by the noise σ; twice that, pooled over
-// all of them, is a second surface in most of them (the riser in a ramp's blocks: 3.9 cm
-// against 1.4 cm at fr079's 10 cm cells).
-constexpr double kMaxSpreadOverNoise = 2.0;
 // A step seen from below is its riser and the nosing above it, and the lower steps, seen
 // more steeply, show a strip of their treads too: a step's band is an edge, its points
 // spread along its own plane by more than the noise (fr079's bands: 1.0-2.4 cm against
@@ -29,7 +25,7 @@ constexpr double kMaxStepSpreadOverNoise = 3.0;
 bool isStepped(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
                double noise) {
   const BlockSpread spread = spreadAlong(grid, blocks, normal);
-  return spread.dof >= kMinDof && spread.rms > kMaxSpreadOverNoise * noise;
+  return spread.dof >= kMinDof && spread.rms > kOneSurfaceSpread * noise;
 }
 
 // The points' mean of block `id` (its cell centre and h where it keeps no points).
@@ -150,7 +146,7 @@ double surfaceOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks
 // 2 σ (a riser's or a wall's piece spreads up it; one or two points tell nothing).
 bool levelBlock(const BlockGrid& grid, std::uint32_t id, double noise) {
   const BlockSpread spread = spreadAlong(grid, {id}, Eigen::Vector3d::UnitZ());
-  return spread.dof >= 2.0 && spread.rms <= kMaxSpreadOverNoise * noise;
+  return spread.dof >= 2.0 && spread.rms <= kOneSurfaceSpread * noise;
 }
 
 // The steps of `segments` that keep a patch: as large as a patch must be and, on their own

@@ -146,25 +146,21 @@ RivalVerdict judgeRivals(const std::vector<TurnedRival>& rivals, const Verificat
   // verified 2.5 m along the corridor, one door spacing off, explaining 43 % of its points; the
   // unturned rival at the start's place found the truth, 58 %, short of rival_replace, and the
   // sequence went on from the slid pose, 1.98 m ATE.)
-  if (verdict.best->nearer_start && verdict.best->within_start && verdict.best->check.constrained &&
-      best_share > kept.explained_share) {
-    verdict.replaces = true;
-    verdict.ambiguous = std::any_of(rivals.begin(), rivals.end(), [&](const TurnedRival& rival) {
-      return &rival != verdict.best && contends(rival, best_share);
-    });
-    return verdict;
-  }
-  if (best_share < config.rival_replace * kept.explained_share) {
-    verdict.ambiguous = true;  // too close to tell
-    return verdict;
-  }
-  // The kept result was itself a turned one: the rival is the better-explained answer, if it
-  // lies within the start's bound and no third comes close to it. (A rival beyond it can explain
-  // more and be wrong: in the held-out symmetric room from 20 deg off a quarter turn 1 m from
-  // the start explained 83 % of the points, the truth 48 %.)
-  if (!verdict.best->within_start) {
-    verdict.ambiguous = true;
-    return verdict;
+  const bool start_decides = verdict.best->nearer_start && verdict.best->within_start &&
+                             verdict.best->check.constrained && best_share > kept.explained_share;
+  if (!start_decides) {
+    if (best_share < config.rival_replace * kept.explained_share) {
+      verdict.ambiguous = true;  // too close to tell
+      return verdict;
+    }
+    // The kept result was itself a turned one: the rival is the better-explained answer, if it
+    // lies within the start's bound and no third comes close to it. (A rival beyond it can
+    // explain more and be wrong: in the held-out symmetric room from 20 deg off a quarter turn
+    // 1 m from the start explained 83 % of the points, the truth 48 %.)
+    if (!verdict.best->within_start) {
+      verdict.ambiguous = true;
+      return verdict;
+    }
   }
   verdict.replaces = true;
   verdict.ambiguous = std::any_of(rivals.begin(), rivals.end(), [&](const TurnedRival& rival) {
