@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 
@@ -118,6 +119,30 @@ void fitPlane(const PcaSums& moments, const Eigen::Vector3d& origin, const Point
   const double sigma = options.noise > 0.0 ? std::min(rms, options.noise) : rms;
   plane.tolerance = std::max(options.min_tolerance, options.sigmas * sigma);
   plane.points = static_cast<std::size_t>(moments.weight);
+}
+
+// Whether a fit of few inner points turns the plane significantly: by more than
+// kInnerTurnSigmas standard errors of its tilt, which its points' residual spread over
+// their extent across the plane's narrower in-plane axis gives: σ / sqrt(n · λ_mid). At
+// least kMinInnerPoints hold it, and it turns the plane by less than kMaxInnerTurn: past
+// 45° the fit lies nearer the perpendicular than the patch's own plane, another surface's
+// points (the simulated corridor's treads at 3 cm of range noise: inner points on the
+// risers turned two tread patches by 68 and 83°, which then took half of two risers).
+constexpr double kInnerTurnSigmas = 3.0;
+constexpr double kMinInnerPoints = 30.0;
+constexpr double kMaxInnerTurn = std::numbers::pi / 4.0;
+
+bool innerFitHolds(const PcaSums& inner, const Eigen::Vector3d& before, const Eigen::Vector3d& after) {
+  if (inner.weight < kMinInnerPoints) return false;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(inner.covariance(), Eigen::EigenvaluesOnly);
+  if (solver.info() != Eigen::Success) return false;
+  const double residual = std::max(0.0, solver.eigenvalues()(0));
+  const double across = solver.eigenvalues()(1);
+  if (!(across > 0.0)) return false;
+  const double tilt_error = std::sqrt(residual / (inner.weight * across));
+  const double turn = std::acos(std::clamp(std::abs(before.dot(after)), 0.0, 1.0));
+  if (turn > kMaxInnerTurn) return false;
+  return turn > kInnerTurnSigmas * tilt_error;
 }
 
 double planeDistance(const PointPlane& plane, const Point& p) {
@@ -298,12 +323,16 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     };
     const std::vector<PcaSums> moments = patchMoments(points, slot_of_point, origin, inner);
     for (std::size_t slot = 1; slot < slots; ++slot) {
-      // Mostly edge (a 17 cm riser between treads at 3 cm of range noise: half of it
-      // within their tolerance): the band left is too thin to hold the plane's tilt, and
-      // the corridor's risers at 3 cm noise came apart on such fits. Keep the second fit.
-      if (moments[slot].weight < kMinInnerShare * static_cast<double>(fitted[slot].points)) continue;
       PointPlane refit = fitted[slot];
       fitPlane(moments[slot], origin[slot], options, refit);
+      // Mostly edge (a 17 cm riser between treads at 3 cm of range noise: half of it
+      // within their tolerance): the band left is too thin to hold the plane's tilt, and
+      // the corridor's risers at 3 cm noise came apart on such fits. Keep the second fit,
+      // unless the inner points hold the tilt well enough that the turn is beyond their
+      // error (innerFitHolds): a riser whose patch took the treads' front strips on both
+      // sides is mostly edge by count, and its second fit leans 10-17° towards them.
+      const bool mostly_edge = moments[slot].weight < kMinInnerShare * static_cast<double>(fitted[slot].points);
+      if (mostly_edge && !innerFitHolds(moments[slot], fitted[slot].normal, refit.normal)) continue;
       fitted[slot].normal = refit.normal;  // the plane alone: tolerance and count stay
       fitted[slot].offset = refit.offset;
     }
