@@ -2,7 +2,7 @@
 """Planes in rooms that someone else's generator made: ../shared/peers/make_scene.py.
 
     /usr/bin/python3 bench/peer_scene.py [--build build] [--peers BUILD-PEERS] [--out out/peer-scene]
-        [--sigmas 0.005,0.01,0.02] [--points 500000,150000] [--turns 0,7,23] [--seeds 1]
+        [--sigmas 0.005,0.01,0.02] [--points 500000,150000] [--turns 0,7,23] [--seeds 1] [--keep]
 
 make_scene.py (the peers' own, not this project's) draws a 10 x 8 x 3 m room, its table top, a
 five-step stair (treads 28 cm, risers 17 cm) and a box, sampled uniformly at random with
@@ -13,7 +13,8 @@ its walls nor its steps lie on cell boundaries; mlmap builds it (--identity, no 
 detects at 0.05 and 0.1 m cells and labels every point (`mlmap label`), and
 ../shared/peers/score.py scores the labels at point IoU >= 0.5 over the planes of >= 300 points
 (--min-gt-points 300: patches touching none of them count neither way), and over the room's
-walls, floor, ceiling and table top alone. With --peers, CGAL's efficient RANSAC on the same
+walls, floor, ceiling and table top alone. Each room's files are removed once scored (--keep
+keeps them: about 150 MB a room). With --peers, CGAL's efficient RANSAC on the same
 cloud (its --eps at 3 sigma, the noise known here) side by side. Skipped with a message where
 ../shared/peers is absent.
 """
@@ -69,8 +70,9 @@ def mlmap_row(mlmap, out, tag, cloud, structural, cell):
     run([mlmap, "-q", "planes", base + ".mlmap", "-o", base + ".planes.mlmap", "--json", base + ".planes.json"])
     detected = time.perf_counter()
     run([mlmap, "-q", "label", base + ".planes.mlmap", "-o", base + ".labels.xyz"] + wide + [cloud])
-    return dict(all=score(cloud, base + ".labels.xyz"), structural=score(structural, base + ".labels.xyz"),
-                build_s=built - start, detect_s=detected - built)
+    row = dict(all=score(cloud, base + ".labels.xyz"), structural=score(structural, base + ".labels.xyz"),
+               build_s=built - start, detect_s=detected - built)
+    return row, [base + suffix for suffix in (".mlmap", ".planes.mlmap", ".labels.xyz")]
 
 
 def cgal_row(peers, out, tag, cloud, structural, sigma):
@@ -78,7 +80,7 @@ def cgal_row(peers, out, tag, cloud, structural, sigma):
     result = json.loads(run([os.path.join(peers, "cgal_ransac"), cloud, "--eps", f"{3 * sigma:g}", "--angle", "20",
                              "--min-support", "200", "--max-planes", "60", "--labels", labels]))
     return dict(all=score(cloud, labels), structural=score(structural, labels),
-                detect_s=result["seconds"]["normals"] + result["seconds"]["detect"])
+                detect_s=result["seconds"]["normals"] + result["seconds"]["detect"]), [labels]
 
 
 def main():
@@ -90,6 +92,7 @@ def main():
     ap.add_argument("--points", default="500000,150000")
     ap.add_argument("--turns", default="0,7,23")
     ap.add_argument("--seeds", default="1")
+    ap.add_argument("--keep", action="store_true", help="keep each room's clouds, maps and labels (~150 MB a room)")
     a = ap.parse_args()
     if not os.path.exists(os.path.join(PEERS, "make_scene.py")):
         print(f"peer_scene: skipped, no ../shared/peers/make_scene.py at {PEERS}")
@@ -105,9 +108,14 @@ def main():
             for turn in map(float, a.turns.split(",")):
                 for seed in map(int, a.seeds.split(",")):
                     tag, cloud, structural = make_room(a.out, sigma, points, turn, seed)
-                    cgal = cgal_row(a.peers, a.out, tag, cloud, structural, sigma) if a.peers else None
+                    made = [cloud, structural]
+                    cgal = None
+                    if a.peers:
+                        cgal, files = cgal_row(a.peers, a.out, tag, cloud, structural, sigma)
+                        made += files
                     for cell in (0.05, 0.1):
-                        r = mlmap_row(mlmap, a.out, tag, cloud, structural, cell)
+                        r, files = mlmap_row(mlmap, a.out, tag, cloud, structural, cell)
+                        made += files
                         rows.append(dict(sigma=sigma, points=points, turn=turn, seed=seed, cell=cell, mlmap=r, cgal=cgal))
                         s, t = r["all"], r["structural"]
                         peer = f"{cgal['all']['f1']:.2f}, {cgal['structural']['f1']:.2f}" if cgal else "-"
@@ -115,6 +123,10 @@ def main():
                         print(f"| {100 * sigma:g} | {points} | {turn:g} | {seed} | {cell:g} | {s['gt_planes']} | "
                               f"{s['pred_planes']}, {s['matched']}, {s['f1']:.2f} | {t['f1']:.2f} | {peer} | "
                               f"{r['build_s'] + r['detect_s']:.2f} / {peer_s} |", flush=True)
+                    if not a.keep:
+                        for path in made:
+                            if os.path.exists(path):
+                                os.remove(path)
     for cell in (0.05, 0.1):
         mine = [r for r in rows if r["cell"] == cell]
         mean = np.mean([r["mlmap"]["all"]["f1"] for r in mine])
