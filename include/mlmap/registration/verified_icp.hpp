@@ -131,7 +131,7 @@ struct VerifiedIcp {
   double source_noise = 0.0;   // m, the source noise used
   int attempts = 0;            // ICP runs (1: no retry)
   int slides = 0;              // of them started where the slide profile peaked
-  double slide_fit = 0.0;      // m, the kept result moved along its weakest direction by fitSlide
+  double slide_fit = 0.0;      // m, the kept result moved along its weakest direction by its facing points (fitSlide, from the slide profile's peak where ICP left it free)
   double first_matched_share = 0.0;  // of the first run: source points matched within the gate
   bool verified = false;       // explains the overlap and the geometry constrains every direction
   bool unconstrained = false;  // explains the overlap but leaves a direction free (a corridor)
