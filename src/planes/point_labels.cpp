@@ -124,10 +124,11 @@ void fitPlane(const PcaSums& moments, const Eigen::Vector3d& origin, const Point
 // Whether a fit of few inner points turns the plane significantly: by more than
 // kInnerTurnSigmas standard errors of its tilt, which its points' residual spread over
 // their extent across the plane's narrower in-plane axis gives: σ / sqrt(n · λ_mid). At
-// least kMinInnerPoints hold it, and it turns the plane by less than kMaxInnerTurn: past
-// 45° the fit lies nearer the perpendicular than the patch's own plane, another surface's
-// points (the simulated corridor's treads at 3 cm of range noise: inner points on the
-// risers turned two tread patches by 68 and 83°, which then took half of two risers).
+// least kMinInnerPoints hold it (fewer give no standard error to trust), and it turns the
+// plane by less than kMaxInnerTurn: past 45° the fit lies nearer the perpendicular than the
+// patch's own plane, another surface's points (the simulated corridor's treads at 3 cm of
+// range noise: inner points on the risers turned two tread patches by 68 and 83°, which then
+// took half of two risers).
 constexpr double kInnerTurnSigmas = 3.0;
 constexpr double kMinInnerPoints = 30.0;
 constexpr double kMaxInnerTurn = std::numbers::pi / 4.0;

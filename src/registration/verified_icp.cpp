@@ -402,7 +402,8 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
     const SlideFit fit = fitSlide(source, surfaces.normals, target, from, direction, bound, kMinFitPoints);
     Pose moved = from;
     if (fit.fitted) moved.translation() += fit.shift * direction;
-    const Verification check = verify(moved);
+    // Where nothing moved it, the check is the kept one's.
+    const Verification check = fit.fitted || peak != 0.0 ? verify(moved) : out.check;
     if (verifiedCheck(check)) {
       out.icp.pose = moved;
       out.check = check;
