@@ -98,6 +98,10 @@ def main():
         print(f"peer_scene: skipped, no ../shared/peers/make_scene.py at {PEERS}")
         return
     mlmap = os.path.join(a.build, "mlmap")
+    if not os.access(mlmap, os.X_OK):
+        sys.exit(f"peer_scene: no mlmap binary at {mlmap} (build it, or give --build)")
+    if a.peers and not os.access(os.path.join(a.peers, "cgal_ransac"), os.X_OK):
+        sys.exit(f"peer_scene: no cgal_ransac in {a.peers} (build ../shared/peers, or leave out --peers)")
     os.makedirs(a.out, exist_ok=True)
     rows = []
     print("| noise cm | points | turn deg | seed | cell m | planes >= 300 pts | mlmap: patches, matched, F1 | "
