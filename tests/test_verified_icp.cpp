@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mlmap/registration/verified_icp.hpp"
+#include "long_corridor.hpp"
 #include "verified_pairs.hpp"
 
 #ifdef MLMAP_HAVE_OPENMP
@@ -227,26 +228,11 @@ TEST_CASE("alignVerified: along a long corridor the points facing its axis fit i
   // `mlmap register`) and the result verified (the slide profile's peak is ±16 cm wide at that
   // noise): the ~40 points facing the axis (niche sides, far end walls) are 1 % of the matched
   // ones. Fitted on those alone (fitSlide) the result lands within 1 cm.
-  const Pair corridor = simulatedPair(R"({
-    "scan_pattern": {"field_of_view_deg": 270, "angular_step_deg": 0.5, "tilt_start_deg": -46,
-                     "tilt_end_deg": 46, "tilt_step_deg": 1.0, "min_range": 0.023, "max_range": 30,
-                     "mount_height": 1.2, "range_sigma": 0.03, "seed": 2},
-    "poses": [{"x": 4.238636799558056, "y": 1.2320939350221156, "yaw_deg": 3.730243442729133},
-              {"x": 5.9563982616421, "y": 1.3528344622133621, "yaw_deg": -3.160279688569007}],
-    "surfaces": [
-      {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [30, 2.2, 0]},
-      {"type": "rectangle", "class": "ceiling", "min": [0, 0, 2.8], "max": [30, 2.2, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 2.2, 2.8], "facing": "+x"},
-      {"type": "rectangle", "class": "wall", "min": [30, 0, 0], "max": [30, 2.2, 2.8], "facing": "-x"},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [30, 0, 2.8], "facing": "+y"},
-      {"type": "rectangle", "class": "wall", "min": [0, 2.2, 0], "max": [30, 2.2, 2.8], "facing": "-y"},
-      {"type": "box", "class": "other", "min": [2.2968, -0.15, 0], "max": [3.2968, 0, 2.1], "omit": ["y+"]},
-      {"type": "box", "class": "other", "min": [8.5626, 2.2, 0], "max": [9.5626, 2.35, 2.1], "omit": ["y-"]},
-      {"type": "box", "class": "other", "min": [14.2367, -0.15, 0], "max": [15.2367, 0, 2.1], "omit": ["y+"]},
-      {"type": "box", "class": "other", "min": [19.3337, 2.2, 0], "max": [20.3337, 2.35, 2.1], "omit": ["y-"]},
-      {"type": "box", "class": "other", "min": [24.3208, -0.15, 0], "max": [25.3208, 0, 2.1], "omit": ["y+"]}
-    ]
-  })", "scene.json", NormalConfig{.max_radius = 0.8});
+  const Pair corridor = simulatedPair(
+      longCorridorJson(R"([{"x": 4.238636799558056, "y": 1.2320939350221156, "yaw_deg": 3.730243442729133},
+                           {"x": 5.9563982616421, "y": 1.3528344622133621, "yaw_deg": -3.160279688569007}])",
+                       {2.2968, 8.5626, 14.2367, 19.3337, 24.3208}, 0.03, 2),
+      "scene.json", NormalConfig{.max_radius = 0.8});
   const VerifiedIcp result =
       alignVerified(corridor.source, corridor.target, startOff(corridor.true_pose, {-0.0177, 0.2481, -0.0523}, 17.89),
                     IcpConfig{.initial_max_distance = 0.5});
