@@ -394,6 +394,15 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
   // on from the first (ATE 13.45 cm, 0.46 now). The held-out long corridor, seed 11 at 30 deg:
   // scan 2 ended 7.3 cm off with no clear peak (22 facing points explained there, 7 away), fitted
   // from there it verifies (ATE 5.35 -> 0.73 cm).
+  // The kept result moved to `moved` along its weakest direction (by `shift`, m), where that
+  // place verifies.
+  const auto keepWhereVerified = [&](const Pose& moved, double shift) {
+    const Verification check = verify(moved);
+    if (!verifiedCheck(check)) return;
+    out.icp.pose = moved;
+    out.check = check;
+    out.slide_fit = shift;
+  };
   if (out.check.good && !verifiedCheck(out.check) && !out.ambiguous) {
     const Eigen::Vector3d direction = out.check.profile.direction;
     const double peak = out.check.profile.better_elsewhere ? out.check.profile.best_shift : 0.0;
@@ -402,13 +411,8 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
     const SlideFit fit = fitSlide(source, surfaces.normals, target, from, direction, bound, kMinFitPoints);
     Pose moved = from;
     if (fit.fitted) moved.translation() += fit.shift * direction;
-    // Where nothing moved it, the check is the kept one's.
-    const Verification check = fit.fitted || peak != 0.0 ? verify(moved) : out.check;
-    if (verifiedCheck(check)) {
-      out.icp.pose = moved;
-      out.check = check;
-      out.slide_fit = peak + (fit.fitted ? fit.shift : 0.0);
-    }
+    // Where nothing moved it, it stays as it is: not verified.
+    if (fit.fitted || peak != 0.0) keepWhereVerified(moved, peak + (fit.fitted ? fit.shift : 0.0));
   }
   // 3. A result that verifies, against its rivals from the start's place a quarter, a half and
   // three quarters of a turn away, and unturned where it lies beyond the start's bound
@@ -446,12 +450,7 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
     if (fit.fitted && minority && std::abs(fit.shift) >= kFitSignificance * fit.standard_error) {
       Pose moved = out.icp.pose;
       moved.translation() += fit.shift * direction;
-      const Verification check = verify(moved);
-      if (verifiedCheck(check)) {
-        out.icp.pose = moved;
-        out.check = check;
-        out.slide_fit = fit.shift;
-      }
+      keepWhereVerified(moved, fit.shift);
     }
   }
   out.verified = verifiedCheck(out.check) && !out.ambiguous;
