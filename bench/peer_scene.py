@@ -2,11 +2,12 @@
 """Planes in rooms that someone else's generator made: ../shared/peers/make_scene.py.
 
     /usr/bin/python3 bench/peer_scene.py [--build build] [--peers BUILD-PEERS] [--out out/peer-scene]
-        [--sigmas 0.005,0.01,0.02] [--points 500000,150000] [--turns 0,7,23] [--seeds 1] [--keep]
+        [--sigmas 0.005,0.01,0.02] [--points 500000,150000] [--turns 0,7,23] [--seeds 1] [--outliers SHARE] [--keep]
 
 make_scene.py (the peers' own, not this project's) draws a 10 x 8 x 3 m room, its table top, a
 five-step stair (treads 28 cm, risers 17 cm) and a box, sampled uniformly at random with
-isotropic Gaussian noise and per-point plane labels: no scanner, no scan lines, so it holds
+isotropic Gaussian noise, uniform outliers in the room's volume (its default 0.5 %; --outliers
+sets the share) and per-point plane labels: no scanner, no scan lines, so it holds
 fixed nothing that the project's simulator holds (beams, line spacing, range noise along the
 beam). Each room is turned about z by each turn and shifted by (1.3, 2.7) cm, so that neither
 its walls nor its steps lie on cell boundaries; mlmap builds it (--identity, no range limits),
@@ -40,15 +41,15 @@ def score(gt, labels):
     return json.loads(run(["/usr/bin/python3", os.path.join(PEERS, "score.py"), gt, labels, "--min-gt-points", "300"]))
 
 
-def make_room(out, sigma, points, turn, seed):
+def make_room(out, sigma, points, turn, seed, outliers=None):
     """The turned, shifted cloud (x y z label) and its structural-only truth."""
-    tag = f"sigma{sigma:g}-points{points}-turn{turn:g}-seed{seed}"
+    tag = f"sigma{sigma:g}-points{points}-turn{turn:g}-seed{seed}" + (f"-outliers{outliers:g}" if outliers is not None else "")
     cloud = os.path.join(out, tag + ".xyz")
     structural = os.path.join(out, tag + ".structural.xyz")
     if not os.path.exists(structural):
         raw = os.path.join(out, tag + ".raw.xyz")
         run(["/usr/bin/python3", os.path.join(PEERS, "make_scene.py"), raw, "--points", str(points),
-             "--sigma", str(sigma), "--seed", str(seed)])
+             "--sigma", str(sigma), "--seed", str(seed)] + ([] if outliers is None else ["--outliers", str(outliers)]))
         data = np.loadtxt(raw)
         a = np.radians(turn)
         rotation = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
@@ -92,6 +93,8 @@ def main():
     ap.add_argument("--points", default="500000,150000")
     ap.add_argument("--turns", default="0,7,23")
     ap.add_argument("--seeds", default="1")
+    ap.add_argument("--outliers", type=float,
+                    help="share of uniform outliers in the room's volume, labelled -1 (default: make_scene.py's, 0.005)")
     ap.add_argument("--keep", action="store_true", help="keep each room's clouds, maps and labels (~150 MB a room)")
     a = ap.parse_args()
     if not os.path.exists(os.path.join(PEERS, "make_scene.py")):
@@ -111,7 +114,7 @@ def main():
         for points in map(int, a.points.split(",")):
             for turn in map(float, a.turns.split(",")):
                 for seed in map(int, a.seeds.split(",")):
-                    tag, cloud, structural = make_room(a.out, sigma, points, turn, seed)
+                    tag, cloud, structural = make_room(a.out, sigma, points, turn, seed, a.outliers)
                     made = [cloud, structural]
                     cgal = None
                     if a.peers:
