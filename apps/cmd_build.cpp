@@ -113,6 +113,14 @@ void addBuildCommand(CLI::App& app, Context& context) {
                     "With --register: never take a scan's tilt and height from its own floor (as `mlmap register "
                     "--no-floor-level`)")
       ->needs(register_flag);
+  addNumber(command, "--outlier-radius", options->input.isolated.radius,
+            "Drop readings with fewer than --outlier-neighbours others within this of them in their own scan, m "
+            "(floating outliers of dense clouds: flying pixels, dust; far sparse readings go too; default 0: keep all)",
+            0.0, Bound::Closed);
+  command->add_option("--outlier-neighbours", options->input.isolated.min_neighbours,
+                      "With --outlier-radius: the others a reading needs within it")
+      ->default_val(2)
+      ->check(CLI::Range(1, 1000));
   addScanOptions(command, options->input,
                  {.poses_help = "TUM pose file, one pose per scan in order (scan i in the sensor frame, pose i "
                                 "maps it to the world); without it each scan's own pose (PCD VIEWPOINT, 3DTK "

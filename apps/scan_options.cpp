@@ -17,6 +17,7 @@ io::ScanInput inputOf(const ScanOptions& options) {
   input.poses = options.poses;
   input.identity = options.identity;
   input.range = options.range;
+  input.isolated = options.isolated;
   return input;
 }
 
@@ -162,6 +163,13 @@ io::ScanInputCounts ScanReading::forEach(const io::ScanSequence::Visit& visit,
       std::fprintf(stderr, "%s: that is most of them; the limits are distances from the scanner, and a scan without a "
                            "pose is seen from its frame's origin: a cloud registered in another frame needs "
                            "--min-range 0 and a --max-range beyond its extent\n", command_.c_str());
+  }
+  if (!quiet_ && counts.isolated > 0) {
+    const io::IsolationFilter& filter = sequence_.input().isolated;
+    std::fprintf(stderr, "%s: dropped %zu isolated readings (%.2f %%: fewer than %d others within %g m, --outlier-radius)\n",
+                 command_.c_str(), counts.isolated,
+                 100.0 * static_cast<double>(counts.isolated) / static_cast<double>(counts.points + counts.isolated),
+                 filter.min_neighbours, filter.radius);
   }
   return counts;
 }

@@ -20,6 +20,7 @@ struct ScanOptions {
   std::string poses;
   bool identity = false;
   io::RangeLimits range;
+  io::IsolationFilter isolated;  // set by the commands that offer it (build)
   std::string mount;  // from `mlmap calibrate`
   std::string up;     // x y z -x -y -z auto; empty: z, with a warning when the data disagree
 };

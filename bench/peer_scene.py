@@ -2,7 +2,8 @@
 """Planes in rooms that someone else's generator made: ../shared/peers/make_scene.py.
 
     /usr/bin/python3 bench/peer_scene.py [--build build] [--peers BUILD-PEERS] [--out out/peer-scene]
-        [--sigmas 0.005,0.01,0.02] [--points 500000,150000] [--turns 0,7,23] [--seeds 1] [--outliers SHARE] [--keep]
+        [--sigmas 0.005,0.01,0.02] [--points 500000,150000] [--turns 0,7,23] [--seeds 1] [--outliers SHARE]
+        [--build-args '--outlier-radius 0.1'] [--keep]
 
 make_scene.py (the peers' own, not this project's) draws a 10 x 8 x 3 m room, its table top, a
 five-step stair (treads 28 cm, risers 17 cm) and a box, sampled uniformly at random with
@@ -62,11 +63,12 @@ def make_room(out, sigma, points, turn, seed, outliers=None):
     return tag, cloud, structural
 
 
-def mlmap_row(mlmap, out, tag, cloud, structural, cell):
+def mlmap_row(mlmap, out, tag, cloud, structural, cell, build_args=()):
     base = os.path.join(out, f"{tag}.cell{cell:g}")
     wide = ["--identity", "--min-range", "0", "--max-range", "1e4"]
     start = time.perf_counter()
-    run([mlmap, "-q", "build", "--no-octree", "--cell-size", str(cell), "-o", base + ".mlmap"] + wide + [cloud])
+    run([mlmap, "-q", "build", "--no-octree", "--cell-size", str(cell), "-o", base + ".mlmap"] + wide + list(build_args) +
+        [cloud])
     built = time.perf_counter()
     run([mlmap, "-q", "planes", base + ".mlmap", "-o", base + ".planes.mlmap", "--json", base + ".planes.json"])
     detected = time.perf_counter()
@@ -95,6 +97,7 @@ def main():
     ap.add_argument("--seeds", default="1")
     ap.add_argument("--outliers", type=float,
                     help="share of uniform outliers in the room's volume, labelled -1 (default: make_scene.py's, 0.005)")
+    ap.add_argument("--build-args", default="", help="more options for `mlmap build`, e.g. '--outlier-radius 0.1'")
     ap.add_argument("--keep", action="store_true", help="keep each room's clouds, maps and labels (~150 MB a room)")
     a = ap.parse_args()
     if not os.path.exists(os.path.join(PEERS, "make_scene.py")):
@@ -121,7 +124,7 @@ def main():
                         cgal, files = cgal_row(a.peers, a.out, tag, cloud, structural, sigma)
                         made += files
                     for cell in (0.05, 0.1):
-                        r, files = mlmap_row(mlmap, a.out, tag, cloud, structural, cell)
+                        r, files = mlmap_row(mlmap, a.out, tag, cloud, structural, cell, a.build_args.split())
                         made += files
                         rows.append(dict(sigma=sigma, points=points, turn=turn, seed=seed, cell=cell, mlmap=r, cgal=cgal))
                         s, t = r["all"], r["structural"]

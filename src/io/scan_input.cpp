@@ -109,6 +109,7 @@ ScanInputCounts ScanSequence::forEach(const Visit& visit, const std::function<vo
       }
       if (outside == scan.size()) requireReadingsInRange(scan, input_.range, input_.files[file], index);
       applyRangeLimits(scan, input_.range);
+      counts.isolated += dropIsolated(scan, input_.isolated);
       scan.pose = input_.world * scan.pose;
       counts.points += scan.size();
       ++counts.scans;

@@ -9,6 +9,7 @@
 #include <functional>
 #include <vector>
 
+#include "mlmap/io/isolated_points.hpp"
 #include "mlmap/io/tum_poses.hpp"
 #include "mlmap/scan.hpp"
 
@@ -54,6 +55,7 @@ struct ScanInput {
   // every scan of a sequence at one pose gives a map of nothing.
   bool identity = false;
   RangeLimits range{};
+  IsolationFilter isolated{};      // off by default; applied after the range limits
   Pose world = Pose::Identity();  // applied after each scan's pose (e.g. turns the data z-up)
 };
 
@@ -62,6 +64,7 @@ struct ScanInputCounts {
   std::size_t points = 0;     // kept
   std::size_t too_near = 0;   // dropped, under range.min
   std::size_t too_far = 0;    // dropped, beyond range.max
+  std::size_t isolated = 0;   // dropped by the isolation filter
 };
 
 class ScanSequence {
