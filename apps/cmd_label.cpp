@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "mlmap/error.hpp"
 #include "mlmap/io/map_file.hpp"
+#include "mlmap/io/planes_json.hpp"
 #include "mlmap/io/xyz.hpp"
 #include "mlmap/planes/point_labels.hpp"
 #include "progress.hpp"
@@ -21,10 +22,12 @@ struct LabelArguments {
   std::string output;
   ScanOptions input;
   bool block_labels = false;
+  std::string json;  // the planes refitted to their labelled points
 };
 
 int runLabel(const LabelArguments& arguments, bool quiet) {
   checkWritable(arguments.output);
+  if (!arguments.json.empty()) checkWritable(arguments.json);
   // Every point is written, in input order: the range limits only decide which ones can
   // carry a label (those outside were never mapped).
   ScanOptions input = arguments.input;
@@ -75,6 +78,11 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
     with_plane += label > 0 ? 1 : 0;
   }
   io::writeXyz(arguments.output, labelled);
+  if (!arguments.json.empty()) {
+    PlaneDetection refitted = *map.planes();
+    refitted.planes = refitToPoints(map.planes()->planes, labelled.points, labelled.labels);
+    io::writePlanesJson(arguments.json, map, refitted, arguments.map);
+  }
   std::printf("%s: %zu points, %zu on a plane (%.1f %%)\n", arguments.output.c_str(), labelled.size(),
               with_plane, labelled.size() == 0 ? 0.0 : 100.0 * static_cast<double>(with_plane) / static_cast<double>(labelled.size()));
   return 0;
@@ -88,6 +96,9 @@ void addLabelCommand(CLI::App& app, Context& context) {
       "label", "Write every scan point in the world frame with the plane id of its block (x y z id, -1 for none)");
   command->add_option("map", arguments->map, "Labelled map (.mlmap, from mlmap planes -o)")->required();
   command->add_option("-o,--output", arguments->output, "Points file to write (.xyz)")->required();
+  command->add_option("--json", arguments->json,
+                      "Also write the planes JSON with each plane refitted to the points labelled with it "
+                      "(normal, offset, centroid and RMS from those points)");
   command->add_flag("--block-labels", arguments->block_labels,
                     "Give every point its block's label as is (default: a point keeps it only when it lies "
                     "on the patch's plane, else takes a neighbouring block's patch it lies on, else none)");

@@ -16,7 +16,9 @@ input point (`mlmap label`, input order). Per marked surface the table gives
   share   the share of its points on its largest patch,
   n10     the patches that hold >= 10 % of its points,
   joins   the other marked surfaces with >= 10 % of their points on that same patch,
-  rms     the RMS of its points to that patch's plane (planes JSON) / to their own least-squares plane, cm;
+  rms     the RMS of its points to that patch's plane (`mlmap label --json`: the plane refitted to the
+          points labelled with it; the planes JSON of `mlmap planes` where label has no --json) / to
+          their own least-squares plane, cm;
 and per scene the points on patches outside every marked surface ("unmarked") and the found surfaces
 whose patch's class (planes JSON `label`) is not the kind marked; at the end, over
 all scans, the surfaces found (and issue 19's split: walls, floor, ceiling >= 90 %, the others
@@ -182,9 +184,12 @@ def run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features
         label += ["--max-range", "1000"]  # every input point keeps its line: labels come in input order
     if "--min-range" in features["label"]:
         label += ["--min-range", "0"]
+    if "--json" in features["label"]:
+        label += ["--json", tag + ".label-planes.json"]  # the planes refitted to their labelled points
     run(label + files)
     table = np.loadtxt(tag + ".labels.xyz", dtype=np.float64, ndmin=2)
-    planes = {p["id"]: (np.array(p["normal"]), p["offset"]) for p in planes_json["planes"]}
+    fitted = json.load(open(tag + ".label-planes.json")) if "--json" in features["label"] else planes_json
+    planes = {p["id"]: (np.array(p["normal"]), p["offset"]) for p in fitted["planes"]}
     classes = {p["id"]: p.get("label") for p in planes_json["planes"]}
     return table[:, :3], table[:, 3].astype(int), planes, classes, dict(build_s=build_s, detect_s=planes_json["timings"]["total_s"])
 

@@ -59,4 +59,15 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
                                           std::span<const Point> points, std::span<std::int32_t> labels,
                                           const PointLabelRefinement& options = {}, const BeamOrigins& beams = {});
 
+// The planes refitted to the points labelled with them (`labels` as refinePointLabels
+// leaves them, ≤ 0 none; `points` world points, the same order): each plane's normal
+// (its side kept), offset, centroid and RMS from the least-squares plane of its points,
+// where at least 3 spread over a surface and that plane turns less than 25° (κ) from the
+// detected one; else the plane as detected. Class, area, outline and ids unchanged. The
+// map's planes are fitted to the points of their blocks; a point-labelled surface also
+// holds the points of its cells the blocks left to no plane and not those of its blocks'
+// other surfaces (`mlmap label --json`).
+std::vector<Plane> refitToPoints(std::span<const Plane> planes, std::span<const Point> points,
+                                 std::span<const std::int32_t> labels);
+
 }  // namespace mlmap
