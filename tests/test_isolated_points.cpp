@@ -57,7 +57,8 @@ std::size_t countLabel(const Scan& scan, std::int32_t label) {
 double tableArea(const Scan& scan) {
   MLMap map(0.1);
   for (const Point& point : scan.points) map.insert(point, 0.03 * 0.03);
-  const std::vector<const Plane*> tables = test::levelPatchesAt(detectPlanes(map), 0.75);
+  const PlaneDetection detection = detectPlanes(map);
+  const std::vector<const Plane*> tables = test::levelPatchesAt(detection, 0.75);
   return tables.empty() ? 0.0 : tables.front()->area;
 }
 
