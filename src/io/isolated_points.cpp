@@ -6,6 +6,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "kept_readings.hpp"
+
 namespace mlmap::io {
 namespace {
 
@@ -66,20 +68,7 @@ std::size_t dropIsolated(Scan& scan, const IsolationFilter& filter) {
     }
     keep[k] = neighbours >= needed ? 1 : 0;
   }
-  const bool with_variances = scan.variances.size() == count;
-  const bool with_labels = scan.labels.size() == count;
-  std::size_t kept = 0;
-  for (std::size_t k = 0; k < count; ++k) {
-    if (keep[k] == 0) continue;
-    scan.points[kept] = scan.points[k];
-    if (with_variances) scan.variances[kept] = scan.variances[k];
-    if (with_labels) scan.labels[kept] = scan.labels[k];
-    ++kept;
-  }
-  scan.points.resize(kept);
-  if (with_variances) scan.variances.resize(kept);
-  if (with_labels) scan.labels.resize(kept);
-  return count - kept;
+  return keepReadings(scan, [&](std::size_t k) { return keep[k] != 0; });
 }
 
 }  // namespace mlmap::io

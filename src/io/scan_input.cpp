@@ -7,6 +7,7 @@
 #include <string>
 
 #include "mlmap/error.hpp"
+#include "kept_readings.hpp"
 #include "mlmap/io/scan_file.hpp"
 
 namespace mlmap::io {
@@ -19,21 +20,7 @@ std::string noPoseMessage(const std::filesystem::path& file) {
 }  // namespace
 
 std::size_t applyRangeLimits(Scan& scan, const RangeLimits& limits) {
-  const bool with_variances = scan.variances.size() == scan.size();
-  const bool with_labels = scan.labels.size() == scan.size();
-  std::size_t kept = 0;
-  for (std::size_t k = 0; k < scan.size(); ++k) {
-    if (!limits.contains(scan.points[k])) continue;
-    scan.points[kept] = scan.points[k];
-    if (with_variances) scan.variances[kept] = scan.variances[k];
-    if (with_labels) scan.labels[kept] = scan.labels[k];
-    ++kept;
-  }
-  const std::size_t dropped = scan.size() - kept;
-  scan.points.resize(kept);
-  if (with_variances) scan.variances.resize(kept);
-  if (with_labels) scan.labels.resize(kept);
-  return dropped;
+  return keepReadings(scan, [&](std::size_t k) { return limits.contains(scan.points[k]); });
 }
 
 void requireReadingsInRange(const Scan& scan, const RangeLimits& limits, const std::filesystem::path& file,
