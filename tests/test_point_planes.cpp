@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <nlohmann/json.hpp>
 #include <random>
 
@@ -60,7 +61,7 @@ TEST_CASE("Planes refitted to their points: normal, offset and RMS from the labe
   const Plane& ceiling = refitted[0];
   CHECK(ceiling.id == 1);
   CHECK(ceiling.normal.z() > 0.0);  // its side kept
-  const double tilt_deg = std::acos(ceiling.normal.z()) * 180.0 / 3.14159265358979323846;
+  const double tilt_deg = std::acos(ceiling.normal.z()) * 180.0 / std::numbers::pi;
   CHECK(tilt_deg == doctest::Approx(0.573).epsilon(0.05));
   // On the plane at the centre: z = 2.52 at x = 2.
   CHECK(std::abs(ceiling.normal.dot(Eigen::Vector3d(2.0, 1.5, 2.52)) + ceiling.offset) < 0.001);

@@ -1,5 +1,6 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <numbers>
 #include <unordered_map>
 
 #include "mlmap/planes/point_labels.hpp"
@@ -37,7 +38,7 @@ std::vector<Plane> refitToPoints(std::span<const Plane> planes, std::span<const 
     s.sum += d;
     s.outer += d * d.transpose();
   }
-  const double min_cosine = std::cos(kMaxTurnDeg * 3.14159265358979323846 / 180.0);
+  const double min_cosine = std::cos(kMaxTurnDeg * std::numbers::pi / 180.0);
   for (std::size_t k = 0; k < refitted.size(); ++k) {
     const Sums& s = sums[k];
     if (s.count < 3.0) continue;
