@@ -147,7 +147,8 @@ def main():
         print(f"CGAL: mean F1 {np.mean([r['cgal']['all']['f1'] for r in cgal]):.3f}, "
               f"walls/floor/ceiling/table {np.mean([r['cgal']['structural']['f1'] for r in cgal]):.3f}")
     load = os.getloadavg()
-    print(f"\n`bench/peer_scene.py` {time.strftime('%Y-%m-%d %H:%M')}, load average {load[0]:.1f} on {os.cpu_count()} cores")
+    given = (f" --outliers {a.outliers:g}" if a.outliers is not None else "") + (f" --build-args='{a.build_args}'" if a.build_args else "")
+    print(f"\n`bench/peer_scene.py{given}` {time.strftime('%Y-%m-%d %H:%M')}, load average {load[0]:.1f} on {os.cpu_count()} cores")
     with open(os.path.join(a.out, "peer_scene.json"), "w") as f:
         json.dump(rows, f, indent=1)
 
