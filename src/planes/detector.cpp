@@ -117,6 +117,19 @@ bool Detector::liesOnPlane(const CandidatePlane& plane, const std::vector<std::u
   return medianDistance(grid_, strict, plane) <= scorer_.bandOf(plane) / 3.0;
 }
 
+// A plumb plane refused for its blocks' direction spread alone: kept in the stats where its
+// blocks cover more than any refused before (a wall's worth tells the user, a corner's
+// facet does not).
+void Detector::noteRefusedWall(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) {
+  if (stats_ == nullptr || std::abs(plane.normal.z()) > std::sin(radians(ClassifyConfig{}.horizontal_deg))) return;
+  double surface = 0.0;
+  for (const std::uint32_t id : strict) surface += grid_.blocks()[id].surface;
+  const double area = surface * grid_.cellSize() * grid_.cellSize();
+  if (area <= stats_->refused_wall_area) return;
+  stats_->refused_wall_area = area;
+  stats_->refused_wall_spread_deg = directionSpread(grid_, directions_, strict, plane);
+}
+
 void Detector::drop(std::size_t index) {
   unlisted_ += static_cast<std::size_t>(candidates_[index].multiplicity);
   candidates_.erase(candidates_.begin() + static_cast<long>(index));
@@ -204,6 +217,7 @@ bool Detector::accept(std::size_t index) {
     cut = *turned;
     strict = std::move(turned_strict);
   } else if (refuses(cut, strict)) {
+    noteRefusedWall(cut, strict);
     refused_.push_back(accepted.plane);
     drop(index);
     return false;

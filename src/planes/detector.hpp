@@ -61,6 +61,7 @@ class Detector {
   bool noiseExplainsSpread(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const;
   bool nearlyLevel(const CandidatePlane& plane) const;
   bool liesOnPlane(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const;
+  void noteRefusedWall(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict);
   SplitPatches splitSheets(const std::vector<std::uint32_t>& matching, const CandidatePlane& plane) const;
   bool accept(std::size_t index);
   void drop(std::size_t index);

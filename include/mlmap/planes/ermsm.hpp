@@ -123,6 +123,12 @@ struct ErmsmStats {
   // direction fields brought up to date from an earlier pass's where σ changed some
   // blocks only (updatedDirectionField: the blocks near them, or all where those are most)
   int direction_updates = 0;
+  // The largest wall-like plane the direction-spread rule refused (of the final pass): the
+  // surface of the blocks that matched it (m²) and their spread (deg; 0: none refused). A
+  // dense cloud with range noise a good part of a cell spreads its walls' directions past
+  // the rule (see README's weak spots); `mlmap planes` says so.
+  double refused_wall_area = 0.0;
+  double refused_wall_spread_deg = 0.0;
   double direction_seconds = 0.0;   // noise estimate, eRMSM blocks and direction vectors
   double detection_seconds = 0.0;   // Algorithm 1 with refits, patch split, merges, classes, labels
   ErmsmStageSeconds stages;         // both, split further
