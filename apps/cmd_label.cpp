@@ -79,8 +79,8 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
   }
   io::writeXyz(arguments.output, labelled);
   if (!arguments.json.empty()) {
-    PlaneDetection refitted = *map.planes();
-    refitted.planes = refitToPoints(map.planes()->planes, labelled.points, labelled.labels);
+    const PlaneDetection refitted{refitToPoints(map.planes()->planes, labelled.points, labelled.labels),
+                                  map.planes()->stats, map.planes()->config};
     io::writePlanesJson(arguments.json, map, refitted, arguments.map);
   }
   std::printf("%s: %zu points, %zu on a plane (%.1f %%)\n", arguments.output.c_str(), labelled.size(),

@@ -121,7 +121,7 @@ bool Detector::liesOnPlane(const CandidatePlane& plane, const std::vector<std::u
 // blocks cover more than any refused before (a wall's worth tells the user, a corner's
 // facet does not).
 void Detector::noteRefusedWall(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) {
-  if (stats_ == nullptr || std::abs(plane.normal.z()) > std::sin(radians(ClassifyConfig{}.horizontal_deg))) return;
+  if (stats_ == nullptr || !isPlumb(plane.normal.cast<double>())) return;
   double surface = 0.0;
   for (const std::uint32_t id : strict) surface += grid_.blocks()[id].surface;
   const double area = surface * grid_.cellSize() * grid_.cellSize();

@@ -4,6 +4,7 @@
 #include <unordered_map>
 
 #include "mlmap/planes/point_labels.hpp"
+#include "pca_sums.hpp"
 
 namespace mlmap {
 namespace {
@@ -13,12 +14,6 @@ namespace {
 // own bound between a block's direction and its plane.
 constexpr double kMaxTurnDeg = 25.0;
 
-struct Sums {
-  double count = 0.0;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();    // about the plane's detected centroid
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-};
-
 }  // namespace
 
 std::vector<Plane> refitToPoints(std::span<const Plane> planes, std::span<const Point> points,
@@ -26,24 +21,19 @@ std::vector<Plane> refitToPoints(std::span<const Plane> planes, std::span<const 
   std::vector<Plane> refitted(planes.begin(), planes.end());
   std::unordered_map<std::int32_t, std::size_t> slot;
   for (std::size_t k = 0; k < refitted.size(); ++k) slot.emplace(refitted[k].id, k);
-  std::vector<Sums> sums(refitted.size());
+  std::vector<PcaSums> sums(refitted.size());  // each about its plane's detected centroid
   const std::size_t count = std::min(points.size(), labels.size());
   for (std::size_t k = 0; k < count; ++k) {
     if (labels[k] <= 0 || !points[k].allFinite()) continue;
     const auto found = slot.find(labels[k]);
     if (found == slot.end()) continue;
-    Sums& s = sums[found->second];
-    const Eigen::Vector3d d = points[k] - refitted[found->second].centroid;
-    s.count += 1.0;
-    s.sum += d;
-    s.outer += d * d.transpose();
+    sums[found->second].add(points[k] - refitted[found->second].centroid, 1.0);
   }
   const double min_cosine = std::cos(kMaxTurnDeg * std::numbers::pi / 180.0);
   for (std::size_t k = 0; k < refitted.size(); ++k) {
-    const Sums& s = sums[k];
-    if (s.count < 3.0) continue;
-    const Eigen::Vector3d mean = s.sum / s.count;
-    const Eigen::Matrix3d covariance = s.outer / s.count - mean * mean.transpose();
+    if (sums[k].weight < 3.0) continue;
+    const Eigen::Vector3d mean = sums[k].mean();
+    const Eigen::Matrix3d covariance = sums[k].covariance();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
     solver.computeDirect(covariance);
     Eigen::Vector3d normal = solver.eigenvectors().col(0);
