@@ -96,3 +96,34 @@ TEST_CASE("eRMSM: a wall's pieces either side of a doorway are one patch, walls 
     }
   }
 }
+
+// Issue 19: "two side corridors' end walls 15.5 m apart (the solid between them never
+// scanned) become one patch": coplanar walls of two rooms, nothing seen between them.
+// A gap is bridged only where the wall was seen over at least as long as is missing.
+TEST_CASE("eRMSM: two corridors' end walls in line, 10 m of unseen solid between them, are two patches") {
+  const auto endWalls = [](const PlaneDetection& detection) {
+    std::vector<const Plane*> walls;
+    for (const Plane& plane : detection.planes) {
+      if (std::abs(plane.normal.y()) > 0.97 && std::abs(std::abs(plane.offset) - 6.0) < 0.05) walls.push_back(&plane);
+    }
+    return walls;
+  };
+  for (const double cell : {0.05, 0.1}) {
+    for (const unsigned seed : {1U, 2U}) {
+      CAPTURE(cell);
+      CAPTURE(seed);
+      const double o = cell / 3.0;
+      test::PlaneSceneBuilder scene(cell, 0.01, seed);
+      // Two side corridors 2 m wide, x 0-2 and x 12-14, each with its floor up to its end
+      // wall at y = 6; between them (x 2-12) a block of rooms nobody entered.
+      scene.withNoise(0.01, 9e-4)
+          .floor(o, o, 2.0 + o, 6.0 + o, 0.0)
+          .floor(12.0 + o, o, 14.0 + o, 6.0 + o, 0.0)
+          .wallY(6.0 + o, o, 2.0 + o, 0.0, 2.5)
+          .wallY(6.0 + o, 12.0 + o, 14.0 + o, 0.0, 2.5);
+      const std::vector<const Plane*> walls = endWalls(detectPlanes(scene.map()));
+      REQUIRE(walls.size() == 2);
+      for (const Plane* wall : walls) CHECK(wall->area == doctest::Approx(2.0 * 2.5).epsilon(0.15));
+    }
+  }
+}

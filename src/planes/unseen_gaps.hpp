@@ -17,7 +17,9 @@ namespace mlmap {
 
 // Joins, along the wall (the plane's horizontal axis), neighbouring pieces of `patches`
 // unless blocks lie on both sides of the plane over the gap between them, further than
-// `epsilon` from it and closer than `reach` (a doorway shows the floor beyond it).
+// `epsilon` from it and closer than `reach` (a doorway shows the floor beyond it), and
+// unless nothing at all lies beside the gap's inside and it is more than twice as long as
+// the pieces either side of it (walls of two rooms in line, the solid between them unseen).
 // Only pieces of at least `min_blocks` blocks and `min_surface` surface units, patches
 // on their own, take part: fragments stay as they are. Planes that are not walls
 // (|n_z| ≥ 0.2) are left alone: between tables at one height the floor shows below and
