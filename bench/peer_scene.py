@@ -3,7 +3,7 @@
 
     /usr/bin/python3 bench/peer_scene.py [--build build] [--peers BUILD-PEERS] [--out out/peer-scene]
         [--sigmas 0.005,0.01,0.02] [--points 500000,150000] [--turns 0,7,23] [--seeds 1] [--outliers SHARE]
-        [--build-args '--outlier-radius 0.1'] [--keep]
+        [--build-args '--outlier-radius 0.1'] [--known-noise] [--keep]
 
 make_scene.py (the peers' own, not this project's) draws a 10 x 8 x 3 m room, its table top, a
 five-step stair (treads 28 cm, risers 17 cm) and a box, sampled uniformly at random with
@@ -17,8 +17,10 @@ detects at 0.05 and 0.1 m cells and labels every point (`mlmap label`), and
 (--min-gt-points 300: patches touching none of them count neither way), and over the room's
 walls, floor, ceiling and table top alone. Each room's files are removed once scored (--keep
 keeps them: about 150 MB a room). With --peers, CGAL's efficient RANSAC on the same
-cloud (its --eps at 3 sigma, the noise known here) side by side. Skipped with a message where
-../shared/peers is absent.
+cloud (its --eps at 3 sigma, the noise known here) side by side. --known-noise gives mlmap the
+noise too (`build --range-sigma` at each room's sigma; by default `build` takes a scanner's 3 cm,
+whose fusion gate is wider than a 5 cm cell and splits the 17 cm risers into level blocks).
+Skipped with a message where ../shared/peers is absent.
 """
 import argparse, json, os, subprocess, sys, time
 
@@ -98,6 +100,8 @@ def main():
     ap.add_argument("--outliers", type=float,
                     help="share of uniform outliers in the room's volume, labelled -1 (default: make_scene.py's, 0.005)")
     ap.add_argument("--build-args", default="", help="more options for `mlmap build`, e.g. '--outlier-radius 0.1'")
+    ap.add_argument("--known-noise", action="store_true",
+                    help="build each room with --range-sigma at its noise (as CGAL gets its --eps)")
     ap.add_argument("--keep", action="store_true", help="keep each room's clouds, maps and labels (~150 MB a room)")
     a = ap.parse_args()
     if not os.path.exists(os.path.join(PEERS, "make_scene.py")):
@@ -124,7 +128,8 @@ def main():
                         cgal, files = cgal_row(a.peers, a.out, tag, cloud, structural, sigma)
                         made += files
                     for cell in (0.05, 0.1):
-                        r, files = mlmap_row(mlmap, a.out, tag, cloud, structural, cell, a.build_args.split())
+                        build_args = a.build_args.split() + (["--range-sigma", f"{sigma:g}"] if a.known_noise else [])
+                        r, files = mlmap_row(mlmap, a.out, tag, cloud, structural, cell, build_args)
                         made += files
                         rows.append(dict(sigma=sigma, points=points, turn=turn, seed=seed, cell=cell, mlmap=r, cgal=cgal))
                         s, t = r["all"], r["structural"]
@@ -147,7 +152,8 @@ def main():
         print(f"CGAL: mean F1 {np.mean([r['cgal']['all']['f1'] for r in cgal]):.3f}, "
               f"walls/floor/ceiling/table {np.mean([r['cgal']['structural']['f1'] for r in cgal]):.3f}")
     load = os.getloadavg()
-    given = (f" --outliers {a.outliers:g}" if a.outliers is not None else "") + (f" --build-args='{a.build_args}'" if a.build_args else "")
+    given = (f" --outliers {a.outliers:g}" if a.outliers is not None else "") + (f" --build-args='{a.build_args}'" if a.build_args else "") + \
+        (" --known-noise" if a.known_noise else "")
     print(f"\n`bench/peer_scene.py{given}` {time.strftime('%Y-%m-%d %H:%M')}, load average {load[0]:.1f} on {os.cpu_count()} cores")
     with open(os.path.join(a.out, "peer_scene.json"), "w") as f:
         json.dump(rows, f, indent=1)
