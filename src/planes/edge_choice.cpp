@@ -206,6 +206,26 @@ std::uint32_t nearerAlongBeam(const Candidate& alone, std::span<const Candidate>
   return chosen;
 }
 
+std::uint32_t surfaceTail(std::uint32_t chosen, const Point& point, std::span<const Candidate> near,
+                          const std::vector<PointPlane>& fitted, double limit, double ratio) {
+  if (chosen == 0) return chosen;
+  const PointPlane& patch = fitted[chosen];
+  std::uint32_t surface = chosen;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const Candidate& c : near) {
+    const PointPlane& other = fitted[c.slot];
+    if (c.slot == chosen || static_cast<double>(other.points) < ratio * static_cast<double>(patch.points) ||
+        std::abs(other.normal.dot(patch.normal)) >= kEdgeCosine)
+      continue;
+    const double units = std::abs(other.normal.dot(point) + other.offset) / other.tolerance;
+    if (units <= limit && units < nearest) {
+      nearest = units;
+      surface = c.slot;
+    }
+  }
+  return surface;
+}
+
 std::int8_t levelSeenFrom(const Plane& plane, const PointPlane& fitted) {
   if (std::abs(fitted.normal.z()) < kLevelCosine) return 0;
   const std::int8_t up = fitted.normal.z() > 0.0 ? 1 : -1;

@@ -113,6 +113,16 @@ std::uint32_t nearerAlongBeam(const Candidate& alone, std::span<const Candidate>
                               const std::vector<PointPlane>& fitted, const std::vector<double>& along_tolerance,
                               double limit);
 
+// A point given to a patch (`chosen`) that lies in the near noise tail of a much larger
+// surface, within `limit` of that surface's tolerances across its plane, goes to that
+// surface when the surface has at least `ratio` times the patch's points and its plane
+// meets the patch's (not parallel): likeliest's edge rule (the larger takes a point on both
+// planes) carried a little past the larger surface's tolerance. At a box's or a bin's foot
+// the floor's points 3-4 σ up lie on the side's plane alone, and one of them makes the side
+// touch the floor in an instance score. Returns the surface, else `chosen`.
+std::uint32_t surfaceTail(std::uint32_t chosen, const Point& point, std::span<const Candidate> near,
+                          const std::vector<PointPlane>& fitted, double limit, double ratio);
+
 // Whether the beam meets the candidate's plane within that patch's range noise
 // (`along_tolerance`). By its rank, not `meets`: a grazing beam (under kMinIncidenceCosine)
 // meets the plane at least |distance| / kMinIncidenceCosine off, where `meets` says 0 (the
