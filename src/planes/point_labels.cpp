@@ -30,18 +30,8 @@ constexpr std::int32_t kNearLevel = 2;
 // How far past a surface's tolerance (3σ) its noise tail is looked for (behindEdge): 6σ,
 // beyond which a normal tail holds one point in 500 million.
 constexpr double kTailTolerances = 2.0;
-// surfaceTail: a point given to a patch goes to a surface with kSurfaceTailRatio times its
-// points whose plane it lies within kSurfaceTailTolerances of (4 σ where the tolerance is
-// 3 σ). make_scene.py's rooms (the peers' generator, bench/peer_scene.py, 2026-12-05): the
-// walls/floor/ceiling/table F1 lost below 1.00 was, in every room traced, a box side, a
-// tread, a riser or a clutter facet holding one or two of a floor's or a wall's points 3-3.6 σ
-// off; with this 0.971 / 0.938 -> 0.986 / 0.978 at 0.05 / 0.1 m (seed 1), 0.881 / 0.879 ->
-// 0.970 / 0.972 on the rooms of seeds 2-3 (not looked at), mean patch F1 0.867 / 0.872 ->
-// 0.871 / 0.873 there (seed 1: 0.873 / 0.851 -> 0.861 / 0.852, a tread by the end wall losing its
-// strip at 2 cm of noise); bench/planes_sweep.py's 60 simulated variants 0.936 -> 0.947 (walls/
-// floor/ceiling/tables 0.924 -> 0.934). At a ratio of 10 the real scans of bench/real_data.py lost 3-5 surfaces
-// (PCL's room scans' walls, 13x smaller than their ceiling, gave it their top strips); at 50
-// they are the same to the row (seeds 1-3).
+// surfaceTail's reach, 4 σ where the tolerance is 3 σ, and the surface's size against the
+// patch's (edge_choice.hpp says what they were measured on).
 constexpr double kSurfaceTailTolerances = 4.0 / 3.0;
 constexpr double kSurfaceTailRatio = 50.0;
 
