@@ -71,4 +71,14 @@ inline std::vector<const Plane*> levelPatchesAt(const PlaneDetection& detection,
   return found;
 }
 
+// The patches facing y (|n_y| > 0.97) whose plane lies within 5 cm of y = `y`, in the
+// detection's order.
+inline std::vector<const Plane*> wallPatchesAtY(const PlaneDetection& detection, double y) {
+  std::vector<const Plane*> found;
+  for (const Plane& plane : detection.planes) {
+    if (std::abs(plane.normal.y()) > 0.97 && std::abs(plane.offset + y * plane.normal.y()) < 0.05) found.push_back(&plane);
+  }
+  return found;
+}
+
 }  // namespace mlmap::test

@@ -59,15 +59,6 @@ TEST_CASE("eRMSM: a desk whose middle strip nobody saw is one patch") {
 // side of doorways 0.45 and 0.6 m wide whose lintels the scan did not reach) are one wall;
 // two walls in line with a room's width between them stay two.
 TEST_CASE("eRMSM: a wall's pieces either side of a doorway are one patch, walls 2 m apart in line are two") {
-  const auto wallsAt = [](const PlaneDetection& detection) {
-    std::vector<const Plane*> walls;
-    for (const Plane& plane : detection.planes) {
-      if (std::abs(plane.normal.y()) > 0.97 && std::abs(plane.offset + 2.0 * plane.normal.y()) < 0.05) {
-        walls.push_back(&plane);
-      }
-    }
-    return walls;
-  };
   for (const double cell : {0.05, 0.1}) {
     for (const unsigned seed : {1U, 2U}) {
       CAPTURE(cell);
@@ -84,7 +75,7 @@ TEST_CASE("eRMSM: a wall's pieces either side of a doorway are one patch, walls 
             .wallY(2.0 + o, o, 3.0 + o, 0.0, 2.4)
             .wallY(2.0 + o, 3.0 + gap + o, 7.0 + o, 0.0, 2.4);
         const PlaneDetection detection = detectPlanes(scene.map());
-        const std::vector<const Plane*> walls = wallsAt(detection);
+        const std::vector<const Plane*> walls = test::wallPatchesAtY(detection, 2.0);
         REQUIRE(!walls.empty());
         if (gap < 1.0) {
           CHECK(walls.size() == 1);
@@ -102,13 +93,6 @@ TEST_CASE("eRMSM: a wall's pieces either side of a doorway are one patch, walls 
 // between them. Such a gap is bridged only where the pieces cover a third of the joined
 // stretch (here 4 m of 14).
 TEST_CASE("eRMSM: two corridors' end walls in line, 10 m of unseen solid between them, are two patches") {
-  const auto endWalls = [](const PlaneDetection& detection) {
-    std::vector<const Plane*> walls;
-    for (const Plane& plane : detection.planes) {
-      if (std::abs(plane.normal.y()) > 0.97 && std::abs(std::abs(plane.offset) - 6.0) < 0.05) walls.push_back(&plane);
-    }
-    return walls;
-  };
   for (const double cell : {0.05, 0.1}) {
     for (const unsigned seed : {1U, 2U}) {
       CAPTURE(cell);
@@ -123,7 +107,7 @@ TEST_CASE("eRMSM: two corridors' end walls in line, 10 m of unseen solid between
           .wallY(6.0 + o, o, 2.0 + o, 0.0, 2.5)
           .wallY(6.0 + o, 12.0 + o, 14.0 + o, 0.0, 2.5);
       const PlaneDetection detection = detectPlanes(scene.map());  // the walls point into it
-      const std::vector<const Plane*> walls = endWalls(detection);
+      const std::vector<const Plane*> walls = test::wallPatchesAtY(detection, 6.0);
       REQUIRE(walls.size() == 2);
       for (const Plane* wall : walls) CHECK(wall->area == doctest::Approx(2.0 * 2.5).epsilon(0.15));
     }
