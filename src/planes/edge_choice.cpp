@@ -217,7 +217,7 @@ std::uint32_t surfaceTail(std::uint32_t chosen, const Point& point, std::span<co
     if (c.slot == chosen || static_cast<double>(other.points) < ratio * static_cast<double>(patch.points) ||
         std::abs(other.normal.dot(patch.normal)) >= kEdgeCosine)
       continue;
-    const double units = std::abs(other.normal.dot(point) + other.offset) / other.tolerance;
+    const double units = planeDistance(other, point) / other.tolerance;
     if (units <= limit && units < nearest) {
       nearest = units;
       surface = c.slot;

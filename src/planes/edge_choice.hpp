@@ -24,6 +24,9 @@ struct Candidate {
   double meets;  // m along the beam from the point to where it meets the plane
 };
 
+// The distance of `p` from the plane (m, unsigned).
+inline double planeDistance(const PointPlane& plane, const Point& p) { return std::abs(plane.normal.dot(p) + plane.offset); }
+
 // A point near a corner of three patches lies on all of them.
 constexpr std::size_t kMaxCandidates = 8;
 

@@ -150,10 +150,6 @@ bool innerFitHolds(const PcaSums& inner, const Eigen::Vector3d& before, const Ei
   return turn > kInnerTurnSigmas * tilt_error;
 }
 
-double planeDistance(const PointPlane& plane, const Point& p) {
-  return std::abs(plane.normal.dot(p) + plane.offset);
-}
-
 }  // namespace
 
 std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plane> planes,
