@@ -86,13 +86,28 @@ double Detector::acceptanceProbability(const Candidate& leader) const {
 // still be a surface: its blocks scatter in height by the range noise, and where that is
 // a good part of a cell (3DTK's ceiling at 5 cm cells: 5.5 cm RMS) their directions
 // spread by more than 8° without any curvature. Accepted when the spread is within the
-// limit on top of that noise (the two adding in squares). Not for walls: a vertical
-// block's direction is uncertain where its window holds a corner or a pillar's turn,
-// which is what the spread rule is for (excusing that let 45° facets across the lab's
-// corners through).
+// limit on top of that noise (the two adding in squares). Walls only where they are
+// wall-sized (wallSized): a vertical block's direction is uncertain where its window
+// holds a corner or a pillar's turn, which is what the spread rule is for (excusing
+// every wall let 45° facets across the lab's corners and a 0.2 m cylinder's through).
 bool Detector::noiseExplainsSpread(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const {
   const double limit = spreadLimit(config_.max_direction_spread_deg, noiseSpread(tilts_, strict, radians(config_.kappa_deg)));
   return !spreadExceeds(grid_, directions_, strict, plane, limit, patch_threads_);
+}
+
+// A plumb plane is excused like a level one (noiseExplainsSpread) where its blocks cover
+// at least this much, m²: a wall's worth, where a corner's or a pillar's facets, which the
+// spread rule is for, cover a window or two. Dense walls with 3 cm of noise at 0.1 m cells
+// spread 8.2-9.6° (make_scene.py's room turned 7°: three of four walls refused, 25-30 m²
+// each); with 2 m² the simulated lab at 3 cm of noise and 5 cm cells also kept facets of
+// 0.8-1.3 m² (planes_sweep.py noise2/noise3: F1 0.948 -> 0.947), with 4 m² none (0.949),
+// and the real scans of bench/real_seeds.py find the same surfaces either way (seeds 1-3).
+constexpr double kWallSizedArea = 4.0;
+
+bool Detector::wallSized(const std::vector<std::uint32_t>& strict) const {
+  double surface = 0.0;
+  for (const std::uint32_t id : strict) surface += grid_.blocks()[id].surface;
+  return surface * grid_.cellSize() * grid_.cellSize() >= kWallSizedArea;
 }
 
 // A level plane within max_direction_spread_deg of level needs no direction test, only
@@ -202,7 +217,8 @@ bool Detector::accept(std::size_t index) {
     const bool level = std::abs(plane.normal.z()) >= std::cos(radians(45.0));
     return (level && !liesOnPlane(plane, blocks)) ||
            (spreadExceeds(grid_, directions_, blocks, plane, config_.max_direction_spread_deg, patch_threads_) &&
-            !(level && (nearlyLevel(plane) || noiseExplainsSpread(plane, blocks))));
+            !(level && (nearlyLevel(plane) || noiseExplainsSpread(plane, blocks))) &&
+            !(!level && wallSized(blocks) && noiseExplainsSpread(plane, blocks)));
   };
   // The plane the patches are cut from: the candidate's, or turned onto its blocks'
   // directions where its fit leans between two layers (direction_fit.hpp) and the tests
