@@ -1,15 +1,14 @@
 #include "mlmap/planes/point_labels.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <optional>
 #include <string>
 
 #include "edge_choice.hpp"
+#include "label_fits.hpp"
 #include "mlmap/error.hpp"
 #include "pca_sums.hpp"
 
@@ -76,80 +75,6 @@ namespace {
 // the points that fit used lie away from the patch's edges: a majority.
 constexpr double kMinInnerShare = 0.5;
 
-// Point chunks of a fixed count, summed in chunk order: the same sums, bit for bit,
-// whatever the thread count.
-constexpr std::int64_t kChunks = 64;
-
-template <typename Accept>
-std::vector<PcaSums> patchMoments(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
-                                  const std::vector<Eigen::Vector3d>& origin, Accept&& accept) {
-  const std::size_t slots = origin.size();
-  std::vector<std::vector<PcaSums>> per_chunk(kChunks);
-  const auto count = static_cast<std::int64_t>(points.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t chunk = 0; chunk < kChunks; ++chunk) {
-    std::vector<PcaSums>& moments = per_chunk[static_cast<std::size_t>(chunk)];
-    moments.assign(slots, PcaSums{});
-    const std::int64_t begin = count * chunk / kChunks;
-    const std::int64_t end = count * (chunk + 1) / kChunks;
-    for (std::int64_t k = begin; k < end; ++k) {
-      const auto index = static_cast<std::size_t>(k);
-      const std::uint32_t slot = slot_of_point[index];
-      if (slot == 0 || !accept(slot, index)) continue;
-      moments[slot].add(points[index] - origin[slot], 1.0);
-    }
-  }
-  std::vector<PcaSums> total(slots);
-  for (const auto& moments : per_chunk)
-    for (std::size_t slot = 0; slot < slots; ++slot) total[slot].addShifted(moments[slot], Eigen::Vector3d::Zero());
-  return total;
-}
-
-// The least-squares plane of the moments, its tolerance from the points' RMS distance.
-void fitPlane(const PcaSums& moments, const Eigen::Vector3d& origin, const PointLabelRefinement& options,
-              PointPlane& plane) {
-  if (moments.weight < 3.0) return;  // keep the detected plane
-  const Eigen::Vector3d mean = moments.mean();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(moments.covariance());
-  if (solver.info() != Eigen::Success) return;
-  Eigen::Vector3d normal = solver.eigenvectors().col(0);
-  if (!normal.allFinite()) return;
-  if (normal.dot(plane.normal) < 0.0) normal = -normal;  // keep the detected orientation
-  const double rms = std::sqrt(std::max(0.0, solver.eigenvalues()(0)));
-  plane.normal = normal;
-  plane.offset = -normal.dot(origin + mean);
-  // A patch's own RMS grows with the points of neighbouring surfaces that its blocks
-  // collected (a table's rim): the sensor's noise, when known, caps it.
-  const double sigma = options.noise > 0.0 ? std::min(rms, options.noise) : rms;
-  plane.tolerance = std::max(options.min_tolerance, options.sigmas * sigma);
-  plane.points = static_cast<std::size_t>(moments.weight);
-}
-
-// Whether a fit of few inner points turns the plane significantly: by more than
-// kInnerTurnSigmas standard errors of its tilt, which its points' residual spread over
-// their extent across the plane's narrower in-plane axis gives: σ / sqrt(n · λ_mid). At
-// least kMinInnerPoints hold it (fewer give no standard error to trust), and it turns the
-// plane by less than kMaxInnerTurn: past 45° the fit lies nearer the perpendicular than the
-// patch's own plane, another surface's points (the simulated corridor's treads at 3 cm of
-// range noise: inner points on the risers turned two tread patches by 68 and 83°, which then
-// took half of two risers).
-constexpr double kInnerTurnSigmas = 3.0;
-constexpr double kMinInnerPoints = 30.0;
-constexpr double kMaxInnerTurn = std::numbers::pi / 4.0;
-
-bool innerFitHolds(const PcaSums& inner, const Eigen::Vector3d& before, const Eigen::Vector3d& after) {
-  if (inner.weight < kMinInnerPoints) return false;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(inner.covariance(), Eigen::EigenvaluesOnly);
-  if (solver.info() != Eigen::Success) return false;
-  const double residual = std::max(0.0, solver.eigenvalues()(0));
-  const double across = solver.eigenvalues()(1);
-  if (!(across > 0.0)) return false;
-  const double tilt_error = std::sqrt(residual / (inner.weight * across));
-  const double turn = std::acos(std::clamp(std::abs(before.dot(after)), 0.0, 1.0));
-  if (turn > kMaxInnerTurn) return false;
-  return turn > kInnerTurnSigmas * tilt_error;
-}
-
 }  // namespace
 
 std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plane> planes,
@@ -207,8 +132,8 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
       const double band = first_band < 0.0 ? plane.tolerance : first_band;
       return band == 0.0 || planeDistance(plane, points[index]) <= band;
     };
-    const std::vector<PcaSums> moments = patchMoments(points, slot_of_point, origin, near_previous);
-    for (std::size_t slot = 1; slot < slots; ++slot) fitPlane(moments[slot], origin[slot], options, fitted[slot]);
+    const std::vector<PcaSums> moments = labelledMoments(points, slot_of_point, origin, near_previous);
+    for (std::size_t slot = 1; slot < slots; ++slot) fitLabelledPlane(moments[slot], origin[slot], options, fitted[slot]);
   }
 
   const double reach = map.cellSize();
@@ -336,10 +261,10 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     const auto inner = [&](std::uint32_t slot, std::size_t index) {
       return at_edge[index] == 0 && planeDistance(fitted[slot], points[index]) <= fitted[slot].tolerance;
     };
-    const std::vector<PcaSums> moments = patchMoments(points, slot_of_point, origin, inner);
+    const std::vector<PcaSums> moments = labelledMoments(points, slot_of_point, origin, inner);
     for (std::size_t slot = 1; slot < slots; ++slot) {
       PointPlane refit = fitted[slot];
-      fitPlane(moments[slot], origin[slot], options, refit);
+      fitLabelledPlane(moments[slot], origin[slot], options, refit);
       // Mostly edge (a 17 cm riser between treads at 3 cm of range noise: half of it
       // within their tolerance): the band left is too thin to hold the plane's tilt, and
       // the corridor's risers at 3 cm noise came apart on such fits. Keep the second fit,
