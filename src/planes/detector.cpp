@@ -87,7 +87,7 @@ double Detector::acceptanceProbability(const Candidate& leader) const {
 // a good part of a cell (3DTK's ceiling at 5 cm cells: 5.5 cm RMS) their directions
 // spread by more than 8° without any curvature. Accepted when the spread is within the
 // limit on top of that noise (the two adding in squares). Walls only where they are
-// wall-sized (wallSized): a vertical block's direction is uncertain where its window
+// wall-sized (kWallSizedArea): a vertical block's direction is uncertain where its window
 // holds a corner or a pillar's turn, which is what the spread rule is for (excusing
 // every wall let 45° facets across the lab's corners and a 0.2 m cylinder's through).
 bool Detector::noiseExplainsSpread(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const {
@@ -110,10 +110,10 @@ bool Detector::noiseExplainsSpread(const CandidatePlane& plane, const std::vecto
 // the curvature's, not the noise's): tests/test_planes_refused_walls.cpp.
 constexpr double kWallSizedArea = 4.0;
 
-bool Detector::wallSized(const std::vector<std::uint32_t>& strict) const {
+double Detector::areaOf(const std::vector<std::uint32_t>& blocks) const {
   double surface = 0.0;
-  for (const std::uint32_t id : strict) surface += grid_.blocks()[id].surface;
-  return surface * grid_.cellSize() * grid_.cellSize() >= kWallSizedArea;
+  for (const std::uint32_t id : blocks) surface += grid_.blocks()[id].surface;
+  return surface * grid_.cellSize() * grid_.cellSize();
 }
 
 // A level plane within max_direction_spread_deg of level needs no direction test, only
@@ -143,9 +143,7 @@ bool Detector::liesOnPlane(const CandidatePlane& plane, const std::vector<std::u
 // facet does not).
 void Detector::noteRefusedWall(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) {
   if (stats_ == nullptr || !isPlumb(plane.normal.cast<double>())) return;
-  double surface = 0.0;
-  for (const std::uint32_t id : strict) surface += grid_.blocks()[id].surface;
-  const double area = surface * grid_.cellSize() * grid_.cellSize();
+  const double area = areaOf(strict);
   if (area <= stats_->refused_wall_area) return;
   stats_->refused_wall_area = area;
   stats_->refused_wall_spread_deg = directionSpread(grid_, directions_, strict, plane);
@@ -223,8 +221,8 @@ bool Detector::accept(std::size_t index) {
     const bool level = std::abs(plane.normal.z()) >= std::cos(radians(45.0));
     return (level && !liesOnPlane(plane, blocks)) ||
            (spreadExceeds(grid_, directions_, blocks, plane, config_.max_direction_spread_deg, patch_threads_) &&
-            !(level && (nearlyLevel(plane) || noiseExplainsSpread(plane, blocks))) &&
-            !(!level && wallSized(blocks) && noiseExplainsSpread(plane, blocks)));
+            !(level ? nearlyLevel(plane) || noiseExplainsSpread(plane, blocks)
+                    : areaOf(blocks) >= kWallSizedArea && noiseExplainsSpread(plane, blocks)));
   };
   // The plane the patches are cut from: the candidate's, or turned onto its blocks'
   // directions where its fit leans between two layers (direction_fit.hpp) and the tests

@@ -60,7 +60,7 @@ class Detector {
   double acceptanceProbability(const Candidate& leader) const;
   bool noiseExplainsSpread(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const;
   bool nearlyLevel(const CandidatePlane& plane) const;
-  bool wallSized(const std::vector<std::uint32_t>& strict) const;
+  double areaOf(const std::vector<std::uint32_t>& blocks) const;  // m², of the blocks' surface
   bool liesOnPlane(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict) const;
   void noteRefusedWall(const CandidatePlane& plane, const std::vector<std::uint32_t>& strict);
   SplitPatches splitSheets(const std::vector<std::uint32_t>& matching, const CandidatePlane& plane) const;
