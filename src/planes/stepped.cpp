@@ -22,6 +22,18 @@ constexpr double kMinDof = 10.0;
 // ../shared/data with a staircase seen from below.
 constexpr double kMaxStepSpreadOverNoise = 3.0;
 
+// m: the bins along the fall line are half of this (or of a cell, where finer). There each
+// block counts as its points lie, a normal density at their mean with their own spread
+// along the line (and a bin's), not as a count in its mean's bin smoothed over a cell: at
+// 10 cm cells that smoothing filled the 5-20 cm gaps between fr079's bands, and the cut left
+// two or three bands in one step. bench/real_seeds.py --only fr079, seeds 1-3, its 20
+// marked surfaces found at 5 / 10 cm cells (of 60): counted in a cell's bins 31 / 33;
+// by their spread with this at 0.1 m 33 / 37, 0.05 m 33 / 38, 0.04 m 33 / 42, 0.03 m
+// 32 / 44, 0.02 m 30 / 48. Counted in bins of 2.5 cm instead, the treads of a flight seen
+// from above at 10 cm cells (blocks 10 cm apart in their cells' centres) came apart at every
+// cell (tests/test_planes_stairs_below.cpp).
+constexpr double kBandWindow = 0.03;
+
 bool isStepped(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
                double noise) {
   const BlockSpread spread = spreadAlong(grid, blocks, normal);
@@ -41,21 +53,24 @@ struct Sample {
   double along = 0.0;
   double weight = 0.0;
   std::uint32_t id = 0;
+  double variance = 0.0;  // m², of its points along the axis
 };
 
 // The ramp's blocks in steps: cut along `axis` (unit: the fall line, or up) at the valleys
 // between the steps. The blocks' points, binned every half `window` along it and smoothed
-// over a window, peak once per step (along the fall line a riser's points share its
-// position; up the flight a tread's share its height); two peaks are two steps where the
-// least between them is at most half the lower one, or two empty bins. Each step's ids
-// ascending.
+// over a window (`spread`: each block a normal density of its points' spread along the
+// axis), peak once per step (along the fall line a riser's points share its position; up
+// the flight a tread's share its height); two peaks are two steps where the least between
+// them is at most half the lower one, or two empty bins. Each step's ids ascending.
 std::vector<std::vector<std::uint32_t>> stepsOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
-                                                const Eigen::Vector3d& axis, double window) {
+                                                const Eigen::Vector3d& axis, double window, bool spread = false) {
   std::vector<Sample> samples;
   samples.reserve(blocks.size());
   for (const std::uint32_t id : blocks) {
-    const double points = grid.pointsOf(id).count;
-    samples.push_back({meanOf(grid, id).dot(axis), std::max(1.0, points), id});
+    const PointStats stats = grid.pointsOf(id);
+    const double points = stats.count;
+    const double variance = stats.count > 1 ? axis.dot(stats.scatterMatrix() * axis) / points : 0.0;
+    samples.push_back({meanOf(grid, id).dot(axis), std::max(1.0, points), id, variance});
   }
   std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.along < b.along; });
   const double bin = window / 2.0;
@@ -66,16 +81,31 @@ std::vector<std::vector<std::uint32_t>> stepsOf(const BlockGrid& grid, const std
   std::vector<std::vector<std::uint32_t>> whole(1, blocks);
   if (!(span < 4.0 * static_cast<double>(samples.size()) + 16.0)) return whole;
   const auto bins = static_cast<std::size_t>(span) + 1;
-  std::vector<double> weight(bins, 0.0);
-  for (const Sample& sample : samples) weight[static_cast<std::size_t>((sample.along - low) / bin)] += sample.weight;
   std::vector<double> density(bins, 0.0);
-  const auto empty = [&](std::size_t b) { return b >= bins || weight[b] == 0.0; };
-  for (std::size_t b = 0; b < bins; ++b) {
-    // Two empty bins in a row stay empty: smoothed, such a gap between two steps would be
-    // no valley (treads a riser apart, 3.5 bins, seen from above). A single empty bin is
-    // the spacing of the blocks' cells (half a cell: the fall line's bins).
-    if (empty(b) && ((b > 0 && empty(b - 1)) || empty(b + 1))) continue;
-    density[b] = 2.0 * weight[b] + (b > 0 ? weight[b - 1] : 0.0) + (b + 1 < bins ? weight[b + 1] : 0.0);
+  if (spread) {
+    // Each block's points spread normally about their mean (and within a bin).
+    for (const Sample& sample : samples) {
+      const double sigma = std::sqrt(sample.variance + bin * bin);
+      const double centre = (sample.along - low) / bin;
+      const auto from = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor(centre - 3.0 * sigma / bin)));
+      const auto to = std::min(static_cast<std::int64_t>(bins) - 1,
+                               static_cast<std::int64_t>(std::ceil(centre + 3.0 * sigma / bin)));
+      for (std::int64_t b = from; b <= to; ++b) {
+        const double z = (static_cast<double>(b) + 0.5 - centre) * bin / sigma;
+        density[static_cast<std::size_t>(b)] += sample.weight * std::exp(-0.5 * z * z) * bin / sigma;
+      }
+    }
+  } else {
+    std::vector<double> weight(bins, 0.0);
+    for (const Sample& sample : samples) weight[static_cast<std::size_t>((sample.along - low) / bin)] += sample.weight;
+    const auto empty = [&](std::size_t b) { return b >= bins || weight[b] == 0.0; };
+    for (std::size_t b = 0; b < bins; ++b) {
+      // Two empty bins in a row stay empty: smoothed, such a gap between two steps would be
+      // no valley (treads a riser apart, 3.5 bins, seen from above). A single empty bin is
+      // the spacing of the blocks' cells (half a cell: the fall line's bins).
+      if (empty(b) && ((b > 0 && empty(b - 1)) || empty(b + 1))) continue;
+      density[b] = 2.0 * weight[b] + (b > 0 ? weight[b - 1] : 0.0) + (b + 1 < bins ? weight[b + 1] : 0.0);
+    }
   }
   // A valley between two steps: the density falls to at most half the step's peak and
   // climbs back to twice the valley's (empty bins between two steps always cut).
@@ -195,20 +225,26 @@ BlockSpread spreadAlong(const BlockGrid& grid, const std::vector<std::uint32_t>&
   return spread;
 }
 
+bool isStaircaseRamp(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
+                     double noise) {
+  const ClassifyConfig classes;
+  return noise > 0.0 && !blocks.empty() && !isLevel(normal, classes) && !isPlumb(normal, classes) &&
+         isStepped(grid, blocks, normal, noise);
+}
+
 std::vector<StepPiece> staircaseSteps(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
                                       const Eigen::Vector3d& normal_in, const Eigen::Vector3d& point,
                                       const StepConfig& config) {
-  if (!(config.noise > 0.0) || blocks.empty()) return {};
-  const ClassifyConfig classes;
   const Eigen::Vector3d normal = normal_in.normalized();
-  if (isLevel(normal, classes) || isPlumb(normal, classes)) return {};
-  if (!isStepped(grid, blocks, normal, config.noise)) return {};
+  if (!isStaircaseRamp(grid, blocks, normal, config.noise)) return {};
+  const ClassifyConfig classes;
   const CandidatePlane reference{normal.cast<float>(), point.cast<float>()};
   Eigen::Vector3d fall(normal.x(), normal.y(), 0.0);
   fall.normalize();
   // Seen from below, a flight's steps are bands apart along its fall line; seen from
   // above, treads at their heights, touching along it: the cut that keeps more steps.
-  KeptSteps bands = keptSteps(grid, stepsOf(grid, blocks, fall, grid.cellSize()), reference, config);
+  KeptSteps bands = keptSteps(grid, stepsOf(grid, blocks, fall, std::min(grid.cellSize(), kBandWindow), true),
+                              reference, config);
   // The treads are the ramp's level blocks (a riser's points spread up it): cut at their
   // heights, a riser apart at least.
   std::vector<std::uint32_t> level_blocks = blocks;

@@ -45,6 +45,19 @@ std::vector<StepPiece> staircaseSteps(const BlockGrid& grid, const std::vector<s
                                       const Eigen::Vector3d& normal, const Eigen::Vector3d& point,
                                       const StepConfig& config);
 
+// m: a step's going, the run from one riser to the next; the bands of a flight seen from
+// below lie this far apart along it (fr079's 0.30-0.35 m, bench/stairs_bench.py's 0.30 m;
+// building codes ask 0.22-0.35 m). The detector keeps a staircase's ramp in one piece
+// across it (Detector::accept). fr079 at 5 cm cells, seed 1 (bench/real_data.py): steps
+// found 2 of 13 with two cells' gap (0.1 m), 4 with 0.2 m, 5 with 0.3 m, 4 with 0.4 m.
+inline constexpr double kStepGoing = 0.3;
+
+// Whether blocks matching a plane (`normal`, unit) are a staircase's ramp, as splitSteps
+// finds one: tilted between the classes' level and plumb tolerances, their points spread
+// along it by more than twice σ (`noise`).
+bool isStaircaseRamp(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
+                     double noise);
+
 // The blocks' points' spread along `normal` (unit), m: the root of their scatter along it
 // pooled over the blocks (each block's about its own mean), and the degrees of freedom it
 // rests on (points less one per block of two points or more).
