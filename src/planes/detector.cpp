@@ -221,10 +221,16 @@ bool Detector::accept(std::size_t index) {
   // The tests an accepted plane must pass, on the blocks it matches.
   const auto refuses = [&](const CandidatePlane& plane, const std::vector<std::uint32_t>& blocks) {
     const bool level = std::abs(plane.normal.z()) >= std::cos(radians(45.0));
-    return (level && !liesOnPlane(plane, blocks)) ||
-           (spreadExceeds(grid_, directions_, blocks, plane, config_.max_direction_spread_deg, patch_threads_) &&
-            !(level ? nearlyLevel(plane) || noiseExplainsSpread(plane, blocks)
-                    : areaOf(blocks) >= kWallSizedArea && noiseExplainsSpread(plane, blocks)));
+    if (level && !liesOnPlane(plane, blocks)) return true;
+    if (!spreadExceeds(grid_, directions_, blocks, plane, config_.max_direction_spread_deg, patch_threads_)) return false;
+    if (level ? nearlyLevel(plane) || noiseExplainsSpread(plane, blocks)
+              : areaOf(blocks) >= kWallSizedArea && noiseExplainsSpread(plane, blocks)) {
+      return false;
+    }
+    // A flight seen from above (treads and risers; stepped.hpp cuts it after the search)
+    // spreads its blocks' directions by design: it is not refused for that.
+    return !isFlightFromAbove(grid_, blocks, plane.normal.cast<double>().normalized(), plane.point.cast<double>(),
+                              StepConfig{config_.noise, config_.min_patch_blocks, config_.min_patch_area});
   };
   // The plane the patches are cut from: the candidate's, or turned onto its blocks'
   // directions where its fit leans between two layers (direction_fit.hpp) and the tests

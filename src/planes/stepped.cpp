@@ -264,6 +264,19 @@ std::vector<StepPiece> staircaseSteps(const BlockGrid& grid, const std::vector<s
   return pieces;
 }
 
+// Three treads, so that a riser between two level pieces (two "treads") is not a flight.
+constexpr std::size_t kMinFlightTreads = 3;
+
+bool isFlightFromAbove(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
+                       const Eigen::Vector3d& point, const StepConfig& config) {
+  if (!isStaircaseRamp(grid, blocks, normal, config.noise)) return false;
+  const std::vector<StepPiece> steps = staircaseSteps(grid, blocks, normal, point, config);
+  const ClassifyConfig classes;
+  return steps.size() >= kMinFlightTreads && std::all_of(steps.begin(), steps.end(), [&](const StepPiece& step) {
+           return isLevel(step.plane.normal.normalized(), classes);
+         });
+}
+
 std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& config) {
   std::size_t cut = 0;
   const std::size_t count = set.planes.size();
