@@ -8,11 +8,11 @@
 #include "fill_vector.hpp"
 #include "mlmap/planes/classify.hpp"
 #include "mlmap/planes/patches.hpp"
+#include "outline_runs.hpp"
 #include "patch_rules.hpp"
 #include "seen_gaps.hpp"
 #include "sheets.hpp"
 #include "stepped.hpp"
-#include "outline_runs.hpp"
 #include "unseen_gaps.hpp"
 
 #ifdef _OPENMP
