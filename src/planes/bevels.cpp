@@ -31,8 +31,7 @@ void dropBevels(const BlockGrid& grid, PatchSet& set, double epsilon, double kap
   const std::size_t count = set.planes.size();
   std::vector<bool> drop(count, false);
   std::vector<double> surface(count, 0.0);
-  for (std::size_t k = 0; k < count; ++k)
-    for (const std::uint32_t id : set.blocks[k]) surface[k] += grid.blocks()[id].surface;
+  for (std::size_t k = 0; k < count; ++k) surface[k] = surfaceOf(grid, set.blocks[k]);
   // The largest patches by surface: the sides a bevel can have (before the walk that
   // finds which it touches, whether any two of them could hold it between them).
   std::vector<std::size_t> by_surface(count);

@@ -113,9 +113,7 @@ bool Detector::noiseExplainsSpread(const CandidatePlane& plane, const std::vecto
 constexpr double kWallSizedArea = 4.0;
 
 double Detector::areaOf(const std::vector<std::uint32_t>& blocks) const {
-  double surface = 0.0;
-  for (const std::uint32_t id : blocks) surface += grid_.blocks()[id].surface;
-  return surface * grid_.cellSize() * grid_.cellSize();
+  return surfaceOf(grid_, blocks) * grid_.cellSize() * grid_.cellSize();
 }
 
 // A level plane within max_direction_spread_deg of level needs no direction test, only

@@ -48,7 +48,7 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
       }
       const Plane& largest = planes[k];
       const CandidatePlane reference{largest.normal.cast<float>(), largest.centroid.cast<float>()};
-      for (const std::uint32_t id : patch.blocks) patch.surface += grid.blocks()[id].surface;
+      patch.surface = surfaceOf(grid, patch.blocks);
       frame = OutlineFrame{largest.normal, largest.centroid, true};
       plane = describePatch(grid, patch, reference, kappa_rad, noise);
       plane.source = largest.source;

@@ -134,6 +134,12 @@ double square(double x) { return x * x; }
 
 }  // namespace
 
+double surfaceOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks) {
+  double surface = 0.0;
+  for (const std::uint32_t id : blocks) surface += grid.blocks()[id].surface;
+  return surface;
+}
+
 Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad,
                     double noise) {
   Plane plane;

@@ -47,6 +47,9 @@ struct PatchSet {
 // cut (stepped.hpp) tells ramps and treads by it.
 inline constexpr double kOneSurfaceSpread = 2.0;
 
+// The surface of blocks (surface units: BlockGrid's), summed in their order.
+double surfaceOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks);
+
 Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad,
                     double noise);
 

@@ -166,12 +166,6 @@ bool growStep(const BlockGrid& grid, std::vector<std::int32_t>& labels, std::vec
   return blocks.size() > before;
 }
 
-double surfaceOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks) {
-  double surface = 0.0;
-  for (const std::uint32_t id : blocks) surface += grid.blocks()[id].surface;
-  return surface;
-}
-
 // Whether block `id` may be a tread's: three points or more, spread up (along z) by at most
 // 2 σ (a riser's or a wall's piece spreads up it; one or two points tell nothing).
 bool levelBlock(const BlockGrid& grid, std::uint32_t id, double noise) {
@@ -269,7 +263,7 @@ constexpr std::size_t kMinFlightTreads = 3;
 
 bool isFlightFromAbove(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Eigen::Vector3d& normal,
                        const Eigen::Vector3d& point, const StepConfig& config) {
-  if (!isStaircaseRamp(grid, blocks, normal, config.noise)) return false;
+  // None where the blocks are no staircase's ramp (staircaseSteps tests that first).
   const std::vector<StepPiece> steps = staircaseSteps(grid, blocks, normal, point, config);
   const ClassifyConfig classes;
   return steps.size() >= kMinFlightTreads && std::all_of(steps.begin(), steps.end(), [&](const StepPiece& step) {
