@@ -69,7 +69,7 @@ std::vector<std::vector<std::uint32_t>> stepsOf(const BlockGrid& grid, const std
   for (const std::uint32_t id : blocks) {
     const PointStats stats = grid.pointsOf(id);
     const double points = stats.count;
-    const double variance = stats.count > 1 ? axis.dot(stats.scatterMatrix() * axis) / points : 0.0;
+    const double variance = spread && stats.count > 1 ? axis.dot(stats.scatterMatrix() * axis) / points : 0.0;
     samples.push_back({meanOf(grid, id).dot(axis), std::max(1.0, points), id, variance});
   }
   std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.along < b.along; });
