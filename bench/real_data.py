@@ -3,6 +3,7 @@
 
     /usr/bin/python3 bench/real_data.py [--build build] [--data ../shared/data] [--out out/real]
         [--cells 0.05,0.1] [--peers /work/build-peers] [--only NAME,...] [--docs docs]
+        [--turn DEG --shift X,Y]
 
 Every scene of bench/real_clouds.py (3DTK's three scans, OctoMap's scan.dat, Bobkov's room 2,
 PCL's office1 and two room scans, plane_seg's two stair scans) has an annotation file
@@ -31,6 +32,10 @@ detection (planes JSON total_s) and build, CGAL's normals + detection.
 Where the data's authors labelled the points themselves (Bobkov's room 2: object parts and
 objects), the labels are scored too, with ../shared/peers/score.py (IoU >= 0.5), for mlmap at
 each cell size and CGAL.
+
+--turn and --shift place the scenes on the cell grid otherwise than their authors' frames do
+(turned about the up axis, moved across by a fraction of a cell); bench/real_seeds.py --placements
+runs twelve such placements, since every constant was tried on the authors' frames.
 
 y-up scans (office1) are passed with `--up y` when `mlmap build --help` lists it, otherwise as
 z-up scans (the benchmark turns them itself). Scans go to mlmap as .xyz files in their sensor
@@ -76,8 +81,17 @@ def quaternion(r):
     return x, y, z, w
 
 
-def write_inputs(scene, folder, up_option):
-    """The .xyz files and pose file (or None) mlmap is given, and the options it needs for the up axis."""
+def yaw_about(up, degrees):
+    """The turn by `degrees` about a scene's up axis ("z" or "y"), in the scene's own frame."""
+    return real_clouds._rotation({"z": 2, "y": 1}[up], degrees)
+
+
+def write_inputs(scene, folder, up_option, yaw=0.0, shift=(0.0, 0.0)):
+    """The .xyz files and pose file (or None) mlmap is given, and the options it needs for the up axis.
+
+    `yaw` (deg) turns the whole scene about its up axis and `shift` (m) moves it across (in the
+    z-up frame) before mlmap sees it: every point keeps its line, so the marked surfaces (found in
+    the annotation frame) still apply."""
     turn = np.eye(3)
     options = []
     if scene.up == "y":
@@ -85,16 +99,20 @@ def write_inputs(scene, folder, up_option):
             options = ["--up", "y"]
         else:
             turn = real_clouds.Y_UP_TO_Z_UP
+    # In the scene's own frame: a y-up scene's x and -z are z-up x and y.
+    across = np.array([shift[0], shift[1], 0.0]) if scene.up == "z" else np.array([shift[0], 0.0, -shift[1]])
+    move = turn @ across
+    turn = turn @ yaw_about(scene.up, yaw)
     files, poses = [], []
     for k, (points, r, t) in enumerate(scene.scans):
         path = os.path.join(folder, f"scan{k:03d}.xyz")
         if scene.sensor_known:
             np.savetxt(path, points, fmt="%.5f")
             qx, qy, qz, qw = quaternion(turn @ r)
-            tt = turn @ t
+            tt = turn @ t + move
             poses.append(f"{k} {tt[0]:.6f} {tt[1]:.6f} {tt[2]:.6f} {qx:.9f} {qy:.9f} {qz:.9f} {qw:.9f}")
         else:
-            np.savetxt(path, (points @ r.T + t) @ turn.T, fmt="%.5f")
+            np.savetxt(path, (points @ r.T + t) @ turn.T + move, fmt="%.5f")
         files.append(path)
     pose_file = None
     if poses:
@@ -161,9 +179,9 @@ def build_map(mlmap, folder, cell, files, pose_file, up_options, features):
     return tag + ".mlmap", build_s
 
 
-def scene_inputs(mlmap, scene, folder, features):
+def scene_inputs(mlmap, scene, folder, features, yaw=0.0, shift=(0.0, 0.0)):
     """The scene's .xyz files, its pose file (registered first where the scene asks) and up options."""
-    files, pose_file, up_options = write_inputs(scene, folder, "--up" in features["build"])
+    files, pose_file, up_options = write_inputs(scene, folder, "--up" in features["build"], yaw, shift)
     if scene.register:
         registered = os.path.join(folder, "registered.tum")
         run([mlmap, "-q", "register", "-o", registered, "--poses", pose_file] + files)
@@ -420,7 +438,17 @@ def main():
     ap.add_argument("--only", help="comma-separated scene names")
     ap.add_argument("--planes-args", default="", help="extra arguments for `mlmap planes`, e.g. \"--noise 0.01\"")
     ap.add_argument("--docs", help="write one picture per scene here (docs/real-NAME.png)")
+    ap.add_argument("--turn", type=float, default=0.0,
+                    help="turn every scene by this many degrees about its up axis (and --shift it) before mlmap "
+                         "sees it: the buildings' walls then lie off the cell grid (CGAL, grid-free, is not rerun)")
+    ap.add_argument("--shift", default="0,0", help="m, with --turn: the scene moved across by x,y (default 0,0)")
     a = ap.parse_args()
+    try:
+        shift = tuple(float(v) for v in a.shift.split(","))
+    except ValueError:
+        shift = ()
+    if len(shift) != 2:
+        raise SystemExit(f"real_data: --shift takes two numbers, x,y (got {a.shift!r})")
     if not os.path.isdir(a.data):
         print(f"real_data: skipped, no data directory at {a.data}")
         return
@@ -452,7 +480,7 @@ def main():
         os.makedirs(folder, exist_ok=True)
         world = scene.world()
         owner = real_annotations.memberships(world, annotation)
-        files, pose_file, up_options = scene_inputs(mlmap, scene, folder, features)
+        files, pose_file, up_options = scene_inputs(mlmap, scene, folder, features, a.turn, shift)
         results, labelled = {}, {}
         for cell in cells:
             points, labels, planes, classes, times = run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features,
@@ -462,7 +490,7 @@ def main():
             rows, extra = score(labels, owner, points, planes, annotation, classes)
             results[f"mlmap {cell:g}"] = dict(rows=rows, extra=extra, times=times)
             labelled[f"mlmap {cell:g} m"] = labels
-        if cgal:
+        if cgal and a.turn == 0.0 and shift == (0.0, 0.0):
             labels, planes, times = run_cgal(a.peers, folder, world)
             rows, extra = score(labels, owner, world, planes, annotation)
             results["CGAL"] = dict(rows=rows, extra=extra, times=times)

@@ -1,19 +1,25 @@
 #!/usr/bin/python3
-"""The real-scan figures across detection seeds: how much of a change is the search's chance.
+"""The real-scan figures across detection seeds and grid placements: how much of a change is chance.
 
     /usr/bin/python3 bench/real_seeds.py [--build build] [--against OTHER_BUILD] [--seeds 1,2,3]
-        [--out out/real-seeds] [--only NAME,...]
+        [--turns 0] [--shifts 0,0] [--placements] [--out out/real-seeds] [--only NAME,...]
 
 eRMSM draws its candidates at random (`mlmap planes --seed`, default 1), and which plane is
 accepted first decides what the others can take. On the real scans of ../shared/data that moves
 bench/real_data.py's counts by more than most changes to the detector do: the same code found
 28, 28 and 25 of the 37 marked walls, floors and ceilings at 5 cm cells with seeds 1, 2 and 3
-(2026-12-03). So a change is judged here on several seeds: bench/real_data.py runs once per
-seed (and per build, with --against), and this prints, per build and cell size, each seed's
-totals and their sum, and with --against which marked surfaces pass in one build and not in
-the other, seed by seed. Skipped with a message where ../shared/data is absent.
+(2026-12-03). The cell grid's placement moves them as much: every real scan lies in the frame its
+authors gave it, the frame every constant of the detector was tried on, and the same scans turned
+by 10-40° about the vertical or moved by a fraction of a cell lose up to 16 of their 64 surfaces at
+10 cm cells (session 47; a surface a cell wide or two layers a cell apart comes out one way or the
+other with the grid). So a change is judged here on several draws: bench/real_data.py runs once
+per seed, turn (deg, about the up axis) and shift (m, "x,y"; --turns and --shifts list them,
+';'-separated for shifts), per build with --against, and this prints, per build and cell size, each
+draw's totals and their sum, and with --against which marked surfaces pass in one build and not in
+the other, draw by draw. --placements is --seeds 1 --turns 0,10,25,40 --shifts "0,0;0.013,0.027;0.05,0.05"
+(twelve placements, the native one among them). Skipped with a message where ../shared/data is absent.
 """
-import argparse, json, os, subprocess, sys
+import argparse, collections, json, os, subprocess, sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -22,6 +28,14 @@ ROOT = os.path.dirname(HERE)
 TOTALS = (("found", "found", "marked"), ("walls/floor/ceiling", "structural_found", "structural"),
           ("others", "other_found", "other"), ("rms", "rms_ok", "marked"), ("stray patches", "stray", None))
 CELLS = ("mlmap 0.05", "mlmap 0.1")
+
+
+class Draw(collections.namedtuple("Draw", "seed turn shift")):
+    """One run of real_data.py: a detection seed, a turn (deg) and a shift ("x,y", m) of the scenes."""
+
+    def name(self):
+        placed = "" if self.turn == 0.0 and self.shift in ("0,0", "0.0,0.0") else f"-turn{self.turn:g}-shift{self.shift}"
+        return f"seed{self.seed}{placed}"
 
 
 def passing(result):
@@ -34,6 +48,10 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--against", help="a second build directory, run on the same seeds and compared")
     ap.add_argument("--seeds", default="1,2,3")
+    ap.add_argument("--turns", default="0", help="deg about the up axis, comma-separated (real_data.py --turn)")
+    ap.add_argument("--shifts", default="0,0", help="m, 'x,y' pairs separated by ';' (real_data.py --shift)")
+    ap.add_argument("--placements", action="store_true",
+                    help="seed 1 on twelve grid placements: turns 0,10,25,40 by shifts 0,0; 0.013,0.027; 0.05,0.05")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "real-seeds"))
     ap.add_argument("--only", help="comma-separated scene names (real_data.py's)")
     ap.add_argument("--data", default=os.path.join(os.path.dirname(ROOT), "shared", "data"))
@@ -42,46 +60,56 @@ def main():
         print(f"real_seeds: skipped, no data directory at {a.data}")
         return
     builds = [("build", a.build)] + ([("against", a.against)] if a.against else [])
-    seeds = [int(s) for s in a.seeds.split(",")]
+    if a.placements:
+        a.seeds, a.turns, a.shifts = "1", "0,10,25,40", "0,0;0.013,0.027;0.05,0.05"
+    try:
+        draws = [Draw(int(seed), float(turn), shift.strip()) for seed in a.seeds.split(",")
+                 for turn in a.turns.split(",") for shift in a.shifts.split(";")]
+        for draw in draws:
+            if len([float(v) for v in draw.shift.split(",")]) != 2:
+                raise ValueError(draw.shift)
+    except ValueError as error:
+        raise SystemExit(f"real_seeds: --seeds, --turns and --shifts take numbers (a shift is 'x,y'): {error}")
     reports = {}
     for tag, build in builds:
-        for seed in seeds:
-            out = os.path.join(a.out, f"{tag}-seed{seed}")
+        for draw in draws:
+            out = os.path.join(a.out, f"{tag}-{draw.name()}")
             cmd = [sys.executable, os.path.join(HERE, "real_data.py"), "--build", build, "--out", out,
-                   "--data", a.data, f"--planes-args=--seed {seed}"] + (["--only", a.only] if a.only else [])
+                   "--data", a.data, f"--planes-args=--seed {draw.seed}", "--turn", f"{draw.turn:g}",
+                   "--shift", draw.shift] + (["--only", a.only] if a.only else [])
             stale = os.path.join(out, "real_data.json")
             if os.path.exists(stale):
                 os.remove(stale)  # a result is this run's or none
-            print(f"real_seeds: {build}, seed {seed}", file=sys.stderr, flush=True)
+            print(f"real_seeds: {build}, {draw.name()}", file=sys.stderr, flush=True)
             done = subprocess.run(cmd, capture_output=True, text=True)
             if done.returncode != 0:
-                raise SystemExit(f"real_seeds: real_data.py failed for {build}, seed {seed}:\n{done.stderr[-2000:]}")
-            reports[(tag, seed)] = os.path.join(out, "real_data.json")
-            if not os.path.exists(reports[(tag, seed)]):
-                raise SystemExit(f"real_seeds: real_data.py scored no scene for {build}, seed {seed}:\n{done.stdout[-2000:]}")
+                raise SystemExit(f"real_seeds: real_data.py failed for {build}, {draw.name()}:\n{done.stderr[-2000:]}")
+            reports[(tag, draw)] = os.path.join(out, "real_data.json")
+            if not os.path.exists(reports[(tag, draw)]):
+                raise SystemExit(f"real_seeds: real_data.py scored no scene for {build}, {draw.name()}:\n{done.stdout[-2000:]}")
     results = {key: json.load(open(path)) for key, path in reports.items()}
-    print("| build | seed | " + " | ".join(f"{name} 0.05 / 0.1" for name, _, _ in TOTALS) + " |")
+    print("| build | draw | " + " | ".join(f"{name} 0.05 / 0.1" for name, _, _ in TOTALS) + " |")
     print("|---|---|" + "---|" * len(TOTALS))
     for tag, build in builds:
         sums = {name: [0, 0] for name, _, _ in TOTALS}
-        for seed in seeds:
-            totals = results[(tag, seed)]["totals"]
+        for draw in draws:
+            totals = results[(tag, draw)]["totals"]
             row = []
             for name, key, _ in TOTALS:
                 values = [totals[cell][key] if cell in totals else 0 for cell in CELLS]
                 sums[name] = [total + value for total, value in zip(sums[name], values)]
                 row.append(" / ".join(map(str, values)))
-            print(f"| {build} | {seed} | " + " | ".join(row) + " |")
-        first = results[(tag, seeds[0])]["totals"]
-        of = [" of " + " / ".join(str(len(seeds) * first[cell][of_key]) for cell in CELLS if cell in first)
+            print(f"| {build} | {draw.name()} | " + " | ".join(row) + " |")
+        first = results[(tag, draws[0])]["totals"]
+        of = [" of " + " / ".join(str(len(draws) * first[cell][of_key]) for cell in CELLS if cell in first)
               if of_key else "" for _, _, of_key in TOTALS]
         print(f"| {build} | sum | " + " | ".join(" / ".join(map(str, sums[name])) + tail
                                               for (name, _, _), tail in zip(TOTALS, of)) + " |")
     if a.against:
         print()
-        for seed in seeds:
-            first, second = passing(results[("build", seed)]), passing(results[("against", seed)])
-            print(f"seed {seed}: found only with {a.build}: {sorted(first - second)}; only with {a.against}: {sorted(second - first)}")
+        for draw in draws:
+            first, second = passing(results[("build", draw)]), passing(results[("against", draw)])
+            print(f"{draw.name()}: found only with {a.build}: {sorted(first - second)}; only with {a.against}: {sorted(second - first)}")
 
 if __name__ == "__main__":
     main()
