@@ -9,6 +9,7 @@
 // staircase now stays whole across a step's going until its steps are cut (11 of 13).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdlib>
 #include <filesystem>
@@ -75,4 +76,49 @@ TEST_CASE("Planes on fr079's flight seen from below: at 5 cm cells most bands ar
   MESSAGE(with_step << " of 13 bands hold a step patch");
   // 4 of 13 before (seed 1), 11 since.
   CHECK(with_step >= 10);
+}
+
+TEST_CASE("Planes on fr079's flight at 10 cm cells moved by a fraction of a cell: no merge joins its steps again") {
+  // The crease split's merge pass (src/planes/ermsm.cpp) ran over every patch, and with the
+  // scan moved by 1.3 and 2.7 cm across the grid it joined the steps cut from one ramp:
+  // steps 7 and 8 into one patch 0.68 m along the flight, steps 10 to 12 into a 2.4 m² ramp
+  // again (4 step patches were left). The steps of one ramp now stay apart (8 step patches,
+  // each under 0.5 m along the flight).
+  const std::filesystem::path scan = mlmap::test::octomapExampleDir() / "scan.dat.bz2";
+  if (!std::filesystem::exists(scan)) {
+    MESSAGE("skipped: " << scan.string() << " is not present (liboctomap-dev's example data)");
+    return;
+  }
+  const mlmap::test::TempDir dir;
+  const std::string xyz = (dir.path() / "scan.xyz").string();
+  REQUIRE(std::system(("bzip2 -dc '" + scan.string() + "' > '" + xyz + "'").c_str()) == 0);
+  const std::string poses = (dir.path() / "moved.tum").string();
+  mlmap::test::writeText(poses, "0 0.013 0.027 0 0 0 0 1\n");
+  const std::string map = (dir.path() / "fr079.mlmap").string();
+  const std::string planes = (dir.path() / "planes.json").string();
+  const auto built =
+      mlmap::test::runCli("-q build '" + xyz + "' --poses '" + poses + "' --cell-size 0.1 --no-octree -o '" + map + "'");
+  REQUIRE_MESSAGE(built.exit_code == 0, built.output);
+  const auto detected = mlmap::test::runCli("-q planes '" + map + "' --threads 2 --seed 1 --json '" + planes + "' -o '" +
+                                            (dir.path() / "planes.mlmap").string() + "'");
+  REQUIRE_MESSAGE(detected.exit_code == 0, detected.output);
+  std::ifstream file(planes);
+  const nlohmann::json json = nlohmann::json::parse(file);
+  int steps = 0;
+  double longest = 0.0;  // m along the flight (x)
+  for (const auto& plane : json["planes"]) {
+    const auto& c = plane["centroid"];
+    const double x = c[0], y = c[1];
+    if (plane["label"] != "step" || x < 5.2 || x > 9.7 || y < -4.2 || y > 1.3) continue;
+    double low = 1e9, high = -1e9;
+    for (const auto& vertex : plane["outline"]) {
+      low = std::min(low, vertex[0].get<double>());
+      high = std::max(high, vertex[0].get<double>());
+    }
+    ++steps;
+    longest = std::max(longest, high - low);
+  }
+  MESSAGE(steps << " step patches on the flight, the longest " << longest << " m along it");
+  CHECK(steps >= 7);
+  CHECK(longest < 0.55);
 }

@@ -271,9 +271,10 @@ bool isFlightFromAbove(const BlockGrid& grid, const std::vector<std::uint32_t>& 
          });
 }
 
-std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& config) {
+std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& config, std::vector<int>* flights) {
   std::size_t cut = 0;
   const std::size_t count = set.planes.size();
+  if (flights != nullptr) flights->assign(count, -1);
   for (std::size_t k = 0; k < count; ++k) {
     const Plane ramp = set.planes[k];
     std::vector<StepPiece> pieces = staircaseSteps(grid, set.blocks[k], ramp.normal, ramp.centroid, config);
@@ -302,6 +303,10 @@ std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& c
       set.planes[slot] = std::move(plane);
       set.blocks[slot] = std::move(pieces[n].blocks);
       slots.push_back(slot);
+      if (flights != nullptr) {
+        flights->resize(set.planes.size(), -1);
+        (*flights)[slot] = static_cast<int>(k);
+      }
     }
     // Then each step along its band, over blocks the ramp did not reach: within the slab a
     // step's points keep (3 σ) and across a gap of a cell (scan lines sparser than cells).

@@ -29,8 +29,11 @@ struct StepConfig {
 // two such steps or more the ramp is cut: its other blocks go back to no patch, the first
 // step takes its id and the others are appended; with fewer it stays as it was (one riser
 // whose patch took the edge of the tread above it is no staircase). Needs the blocks'
-// point moments. Returns the number of ramps cut.
-std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& config);
+// point moments. Returns the number of ramps cut; `flights` (optional), per plane, the index
+// of the ramp its step was cut from (-1 for none): a later merge keeps them apart
+// (mergeCoplanar's families), as their ramp's steps.
+std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& config,
+                       std::vector<int>* flights = nullptr);
 
 // A staircase's step: its blocks (ascending), their surface (surface units) and its plane
 // (describePatch's, on all of its blocks' points; id, source and candidates unset).
