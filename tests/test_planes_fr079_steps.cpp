@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -42,26 +43,42 @@ constexpr std::array<Band, 13> kBands{{{5.28, 5.56, -0.05, 0.15},
                                        {8.98, 9.28, 1.53, 1.70},
                                        {9.32, 9.58, 1.68, 1.85}}};
 
-}  // namespace
-
-TEST_CASE("Planes on fr079's flight seen from below: at 5 cm cells most bands are a step") {
+// fr079's planes JSON at `cell` m, the scan moved by `shift` (x y, m) through a pose file or
+// left where it is (--identity) without one; nullopt, with a message, where liboctomap-dev's
+// example file is absent.
+std::optional<nlohmann::json> fr079Planes(double cell, const std::string& shift = "") {
   const std::filesystem::path scan = mlmap::test::octomapExampleDir() / "scan.dat.bz2";
   if (!std::filesystem::exists(scan)) {
     MESSAGE("skipped: " << scan.string() << " is not present (liboctomap-dev's example data)");
-    return;
+    return std::nullopt;
   }
   const mlmap::test::TempDir dir;
   const std::string xyz = (dir.path() / "scan.xyz").string();
   REQUIRE(std::system(("bzip2 -dc '" + scan.string() + "' > '" + xyz + "'").c_str()) == 0);
+  std::string placement = "--identity";
+  if (!shift.empty()) {
+    const std::string poses = (dir.path() / "moved.tum").string();
+    mlmap::test::writeText(poses, "0 " + shift + " 0 0 0 0 1\n");
+    placement = "--poses '" + poses + "'";
+  }
   const std::string map = (dir.path() / "fr079.mlmap").string();
   const std::string planes = (dir.path() / "planes.json").string();
-  const auto built = mlmap::test::runCli("-q build '" + xyz + "' --identity --cell-size 0.05 --no-octree -o '" + map + "'");
+  const auto built = mlmap::test::runCli("-q build '" + xyz + "' " + placement + " --cell-size " + std::to_string(cell) +
+                                         " --no-octree -o '" + map + "'");
   REQUIRE_MESSAGE(built.exit_code == 0, built.output);
   const auto detected = mlmap::test::runCli("-q planes '" + map + "' --threads 2 --seed 1 --json '" + planes + "' -o '" +
                                             (dir.path() / "planes.mlmap").string() + "'");
   REQUIRE_MESSAGE(detected.exit_code == 0, detected.output);
   std::ifstream file(planes);
-  const nlohmann::json json = nlohmann::json::parse(file);
+  return nlohmann::json::parse(file);
+}
+
+}  // namespace
+
+TEST_CASE("Planes on fr079's flight seen from below: at 5 cm cells most bands are a step") {
+  const auto detected = fr079Planes(0.05);
+  if (!detected) return;
+  const nlohmann::json& json = *detected;
   int with_step = 0;
   for (const Band& band : kBands) {
     bool found = false;
@@ -84,26 +101,9 @@ TEST_CASE("Planes on fr079's flight at 10 cm cells moved by a fraction of a cell
   // steps 7 and 8 into one patch 0.68 m along the flight, steps 10 to 12 into a 2.4 m² ramp
   // again (4 step patches were left). The steps of one ramp now stay apart (8 step patches,
   // each under 0.5 m along the flight).
-  const std::filesystem::path scan = mlmap::test::octomapExampleDir() / "scan.dat.bz2";
-  if (!std::filesystem::exists(scan)) {
-    MESSAGE("skipped: " << scan.string() << " is not present (liboctomap-dev's example data)");
-    return;
-  }
-  const mlmap::test::TempDir dir;
-  const std::string xyz = (dir.path() / "scan.xyz").string();
-  REQUIRE(std::system(("bzip2 -dc '" + scan.string() + "' > '" + xyz + "'").c_str()) == 0);
-  const std::string poses = (dir.path() / "moved.tum").string();
-  mlmap::test::writeText(poses, "0 0.013 0.027 0 0 0 0 1\n");
-  const std::string map = (dir.path() / "fr079.mlmap").string();
-  const std::string planes = (dir.path() / "planes.json").string();
-  const auto built =
-      mlmap::test::runCli("-q build '" + xyz + "' --poses '" + poses + "' --cell-size 0.1 --no-octree -o '" + map + "'");
-  REQUIRE_MESSAGE(built.exit_code == 0, built.output);
-  const auto detected = mlmap::test::runCli("-q planes '" + map + "' --threads 2 --seed 1 --json '" + planes + "' -o '" +
-                                            (dir.path() / "planes.mlmap").string() + "'");
-  REQUIRE_MESSAGE(detected.exit_code == 0, detected.output);
-  std::ifstream file(planes);
-  const nlohmann::json json = nlohmann::json::parse(file);
+  const auto detected = fr079Planes(0.1, "0.013 0.027");
+  if (!detected) return;
+  const nlohmann::json& json = *detected;
   int steps = 0;
   double longest = 0.0;  // m along the flight (x)
   for (const auto& plane : json["planes"]) {
