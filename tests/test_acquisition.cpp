@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <thread>
 
 #include "helpers.hpp"
 #include "mlmap/driver/acquisition.hpp"
@@ -114,12 +115,42 @@ struct Run {
   std::size_t skipped_revolutions = 0;  // the emulator could not keep up
 };
 
+// A device whose client thread loses the processor right after writing a command that
+// starts with `prefix`, as on a loaded machine: the device answers before the client
+// reads its clock again.
+class PreemptedAfterWrite : public Transport {
+ public:
+  PreemptedAfterWrite(Transport& inner, std::string prefix, std::chrono::milliseconds pause)
+      : inner_(inner), prefix_(std::move(prefix)), pause_(pause) {}
+  void write(std::string_view bytes) override {
+    inner_.write(bytes);
+    if (!prefix_.empty() && bytes.starts_with(prefix_)) std::this_thread::sleep_for(pause_);
+  }
+  std::size_t read(char* buffer, std::size_t capacity, std::chrono::milliseconds timeout) override {
+    return inner_.read(buffer, capacity, timeout);
+  }
+  double now() const override { return inner_.now(); }
+  const std::string& name() const override { return inner_.name(); }
+
+ private:
+  Transport& inner_;
+  std::string prefix_;
+  std::chrono::milliseconds pause_;
+};
+
+// The PTU's client is preempted for `pause` after each command starting with `prefix`.
+struct PtuPreemption {
+  std::string prefix;
+  std::chrono::milliseconds pause{0};
+};
+
 Run sweep(const mlmap::sim::Scene& scene, const EmulatorOptions& emulator_options,
-          const SweepOptions& options = sweepOptions()) {
+          const SweepOptions& options = sweepOptions(), const PtuPreemption& preemption = {}) {
   Emulator emulator(scene, emulator_options);
   Devices devices(emulator);
+  PreemptedAfterWrite ptu_device(*devices.ptu, preemption.prefix, preemption.pause);
   ScipClient laser(*devices.laser, std::chrono::milliseconds(options.timeout_ms));
-  PtuClient ptu(*devices.ptu, std::chrono::milliseconds(options.timeout_ms));
+  PtuClient ptu(ptu_device, std::chrono::milliseconds(options.timeout_ms));
   Run run;
   const auto start = std::chrono::steady_clock::now();
   run.result = acquireScan(laser, ptu, options, basePose());
@@ -158,6 +189,24 @@ TEST_CASE("Driver end to end: exact ranges land on the scene's surfaces") {
   const Distances distances = surfaceDistances(scene, result.scan);
   CHECK(distances.worst < 0.002 + tilt_speed * result.sync_uncertainty_s * 7.0);
   CHECK(distances.rms < 0.002 + tilt_speed * result.sync_uncertainty_s * 4.0);
+}
+
+TEST_CASE("Driver end to end: a client preempted after each write keeps t_0 within its bound") {
+  // CI under ASan saw t_0 7.6 ms (laser clock) off with a bound of 1.6 ms: the clients read
+  // the clock after writing TP, so a thread descheduled in between took the reply's
+  // moment for the command's. The transports now stamp a write before it goes out.
+  const auto scene = room();
+  auto options = emulatorOptions();
+  options.range_sigma = 0.0;
+  const Run run = sweep(scene, options, sweepOptions(), {"TP", std::chrono::milliseconds(8)});
+  MESSAGE("preempted 8 ms after each TP: time-sync error " << run.sync_error_s * 1e3 << " ms (bound "
+                                                          << run.result.sync_uncertainty_s * 1e3 << " ms)");
+  CHECK(run.result.scan.size() > 43 * 1081 * 0.95);
+  CHECK(run.sync_error_s <= run.result.sync_uncertainty_s);
+  // 8 ms of host time is 32 ms on the emulator's clock (time scale 4): the bound must see
+  // half of it, and no more than what the pause and a loaded machine explain.
+  CHECK(run.result.sync_uncertainty_s >= 0.016);
+  CHECK(run.result.sync_uncertainty_s <= 0.1);
 }
 
 TEST_CASE("Driver end to end: 1 cm range noise, laser over loopback TCP") {

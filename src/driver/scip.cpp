@@ -416,7 +416,8 @@ ClockModel fitClock(const std::vector<ScipClient::TimeSample>& samples) {
   model.offset_s = mean_device - model.rate * mean_host;
   for (const auto& sample : samples) {
     const double residual = std::abs(model.toDevice(sample.host_s) - sample.device_s);
-    model.max_residual_s = std::max(model.max_residual_s, residual + 0.5 * sample.round_trip_s);
+    // The round trip is host time; the residual and the bound are on the device's clock.
+    model.max_residual_s = std::max(model.max_residual_s, residual + 0.5 * sample.round_trip_s * model.rate);
   }
   return model;
 }

@@ -67,6 +67,7 @@ FdTransport::~FdTransport() {
 }
 
 void FdTransport::write(std::string_view bytes) {
+  last_s_ = hostSeconds();  // before the bytes leave: the device cannot answer earlier
   std::size_t done = 0;
   while (done < bytes.size()) {
     // A socket whose peer has gone must fail with EPIPE, not raise SIGPIPE and end the
@@ -93,6 +94,7 @@ std::size_t FdTransport::read(char* buffer, std::size_t capacity, std::chrono::m
         deadline - std::chrono::steady_clock::now());
     pollfd waiter{fd_, POLLIN, 0};
     const int ready = ::poll(&waiter, 1, static_cast<int>(std::max<std::int64_t>(0, left.count())));
+    last_s_ = hostSeconds();  // after the bytes arrived: they were sent earlier
     if (ready < 0) {
       if (errno == EINTR) continue;
       throw Error(systemError(name_ + ": poll"));

@@ -83,7 +83,7 @@ struct ScipScan {
 struct ClockModel {
   double offset_s = 0.0;
   double rate = 1.0;
-  double max_residual_s = 0.0;  // worst fit residual (+ half the worst round trip)
+  double max_residual_s = 0.0;  // s of device time: worst fit residual + half its round trip
   double toDevice(double host_s) const { return offset_s + rate * host_s; }
 };
 

@@ -1,8 +1,11 @@
 // A byte channel to a device (section III's laser and pan-tilt unit): a serial port
 // (termios, raw mode; the UTM-30LX is a USB ACM device), a TCP socket (Ethernet Hokuyo
 // models, port 10940) or, in tests, a pseudo-terminal. Every read has a timeout, so no
-// caller can hang on a silent device. `now()` is the host time of the last byte moved,
-// which lets a replayed log (raw_log.hpp) give the clients the recorded times.
+// caller can hang on a silent device. `now()` is the host time when the last write
+// began or the last read ended: a reply can neither be caused before the first nor have
+// arrived after the second, so the pair brackets the device's action even when the
+// calling thread loses the processor between a system call and its clock reading. A
+// replayed log (raw_log.hpp) gives the clients the recorded times the same way.
 #pragma once
 
 #include <chrono>
@@ -25,7 +28,7 @@ class Transport {
   // Up to `capacity` bytes into `buffer`, waiting at most `timeout`; 0 on timeout.
   // Throws mlmap::Error when the device is gone (hang-up, end of stream, I/O error).
   virtual std::size_t read(char* buffer, std::size_t capacity, std::chrono::milliseconds timeout) = 0;
-  // s, host time of the last write or read (replay: the recorded time).
+  // s, host time when the last write began or the last read ended (replay: recorded).
   virtual double now() const { return hostSeconds(); }
   // Device name for messages: "/dev/ttyACM0", "tcp:host:10940".
   virtual const std::string& name() const = 0;
@@ -42,12 +45,14 @@ class FdTransport : public Transport {
   void write(std::string_view bytes) override;
   std::size_t read(char* buffer, std::size_t capacity, std::chrono::milliseconds timeout) override;
   const std::string& name() const override { return name_; }
+  double now() const override { return last_s_; }
   int fd() const { return fd_; }
 
  private:
   int fd_;
   std::string name_;
   bool socket_ = false;
+  double last_s_ = hostSeconds();
 };
 
 // Opens a serial device in raw mode (8N1, no flow control, no echo) at `baud`
