@@ -27,6 +27,32 @@ void fitLabelledPlane(const PcaSums& moments, const Eigen::Vector3d& origin, con
   plane.points = static_cast<std::size_t>(moments.weight);
 }
 
+std::vector<double> ownNoise(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
+                             const std::vector<PointPlane>& planes, double band) {
+  std::vector<std::vector<float>> distances(planes.size());
+  for (std::size_t index = 0; index < points.size(); ++index) {
+    const std::uint32_t slot = slot_of_point[index];
+    if (slot == 0) continue;
+    const PointPlane& plane = planes[slot];
+    const double distance = plane.normal.dot(points[index]) + plane.offset;
+    if (band == 0.0 || std::abs(distance) <= band) distances[slot].push_back(static_cast<float>(distance));
+  }
+  const auto median = [](std::vector<float>& values) {
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return static_cast<double>(*middle);
+  };
+  std::vector<double> sigma(planes.size(), 0.0);
+  for (std::size_t slot = 1; slot < planes.size(); ++slot) {
+    std::vector<float>& values = distances[slot];
+    if (values.size() < 3) continue;
+    const double centre = median(values);
+    for (float& value : values) value = static_cast<float>(std::abs(value - centre));
+    sigma[slot] = 1.4826 * median(values);
+  }
+  return sigma;
+}
+
 // Whether a fit of few inner points turns the plane significantly: by more than
 // kInnerTurnSigmas standard errors of its tilt, which its points' residual spread over
 // their extent across the plane's narrower in-plane axis gives: σ / sqrt(n · λ_mid). At

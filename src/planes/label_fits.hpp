@@ -50,6 +50,13 @@ std::vector<PcaSums> labelledMoments(std::span<const Point> points, std::span<co
 void fitLabelledPlane(const PcaSums& moments, const Eigen::Vector3d& origin, const PointLabelRefinement& options,
                       PointPlane& plane);
 
+// Per slot (slot_of_point; 0: none), the robust σ of its points' signed distances from
+// planes[slot], of those within `band` of it (0: all): 1.4826 × their median absolute
+// deviation from their median (σ for Gaussian noise, unmoved by a minority of outliers
+// and by a plane a few millimetres off); 0 where fewer than 3 points.
+std::vector<double> ownNoise(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
+                             const std::vector<PointPlane>& planes, double band);
+
 // Whether a fit of few inner points turns the plane (normal `before` -> `after`)
 // significantly (label_fits.cpp).
 bool innerFitHolds(const PcaSums& inner, const Eigen::Vector3d& before, const Eigen::Vector3d& after);

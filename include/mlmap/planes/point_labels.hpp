@@ -52,6 +52,10 @@ struct BeamOrigins {
 // range noise reaches is no candidate beside one it meets within it, and a point past a
 // surface's plane from its scanner, in that surface's noise tail, is the surface's, not
 // that of a patch ending at the plane on the scanner's side (a box on the floor).
+// With `noise` set (it caps the tolerances), a point left on none goes back to its block's
+// patch where it lies within `sigmas` × that patch's own robust σ (of its points within
+// `band`) and no other patch lies near it: a surface noisier than the map (a far wall of a
+// depth camera) keeps its tails.
 // `labels` are labelPoints' (any value ≤ 0 is "none"); `points` are world points.
 // Returns the refitted planes in id order (ids ≤ 0 and repeats left out). Deterministic
 // at any thread count.
