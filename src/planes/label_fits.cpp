@@ -35,6 +35,7 @@ std::vector<double> ownNoise(std::span<const Point> points, std::span<const std:
     if (slot == 0) continue;
     const PointPlane& plane = planes[slot];
     const double distance = plane.normal.dot(points[index]) + plane.offset;
+    if (!std::isfinite(distance)) continue;  // a non-finite point says nothing of the noise
     if (band == 0.0 || std::abs(distance) <= band) distances[slot].push_back(static_cast<float>(distance));
   }
   const auto median = [](std::vector<float>& values) {
