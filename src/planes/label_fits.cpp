@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "median.hpp"
+
 namespace mlmap {
 
 // The least-squares plane of the moments, its tolerance from the points' RMS distance.
@@ -45,18 +47,13 @@ std::vector<double> ownNoise(std::span<const Point> points, std::span<const std:
     if (!std::isfinite(distance)) continue;  // a non-finite point says nothing of the noise
     if (band == 0.0 || std::abs(distance) <= band) distances[slot].push_back(static_cast<float>(distance));
   }
-  const auto median = [](std::vector<float>& values) {
-    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    return static_cast<double>(*middle);
-  };
   std::vector<double> sigma(planes.size(), 0.0);
   for (std::size_t slot = 1; slot < planes.size(); ++slot) {
     std::vector<float>& values = distances[slot];
     if (values.size() < 3) continue;
-    const double centre = median(values);
+    const double centre = medianOf(values);
     for (float& value : values) value = static_cast<float>(std::abs(value - centre));
-    sigma[slot] = 1.4826 * median(values);
+    sigma[slot] = 1.4826 * medianOf(values);
   }
   return sigma;
 }

@@ -362,10 +362,9 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     chosen = surfaceTail(chosen, points[index], std::span(near.data(), near_found), fitted, kSurfaceTailTolerances,
                          kSurfaceTailRatio);
     const std::uint32_t own = slot_of_point[index];
-    const bool only_own_near = std::all_of(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(near_found),
-                                           [own](const Candidate& c) { return c.slot == own; });
-    if (chosen == 0 && own != 0 && only_own_near &&
-        planeDistance(fitted[own], points[index]) <= options.sigmas * own_noise[own])
+    if (chosen == 0 && own != 0 && planeDistance(fitted[own], points[index]) <= options.sigmas * own_noise[own] &&
+        std::all_of(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(near_found),
+                    [own](const Candidate& c) { return c.slot == own; }))
       chosen = own;
     labels[index] = chosen != 0 ? fitted[chosen].id : labels[index] < 0 ? -1 : 0;
   }
