@@ -121,6 +121,14 @@ std::optional<std::pair<double, double>> OutlineReach::of(std::uint32_t a, std::
   return std::pair<double, double>{found->second.first, found->second.second};
 }
 
+std::vector<std::pair<std::uint32_t, std::uint32_t>> OutlineReach::pairs() const {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> keys;
+  keys.reserve(reach_.size());
+  for (const auto& [key, extent] : reach_)
+    keys.emplace_back(static_cast<std::uint32_t>(key >> 32), static_cast<std::uint32_t>(key & 0xffffffffU));
+  return keys;
+}
+
 std::uint32_t behindEdge(std::uint32_t chosen, const Point& point, const Point* scanner,
                          std::span<const Candidate> candidates, const std::vector<PointPlane>& fitted,
                          const std::vector<double>& along_tolerance, const std::vector<std::int8_t>& seen_from,

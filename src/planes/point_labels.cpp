@@ -9,6 +9,7 @@
 
 #include "edge_choice.hpp"
 #include "label_fits.hpp"
+#include "patch_sides.hpp"
 #include "mlmap/error.hpp"
 #include "pca_sums.hpp"
 
@@ -314,6 +315,14 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
             return true;
     return false;
   };
+  // Whether the beam meets a's plane past b's where a's patch ends at b's plane (likeliest;
+  // PatchSides says where a patch ends, from its outline and from its points on it alone).
+  const PatchSides sides(points, sole, fitted, outline_reach, kEdgeCosine, reach);
+  const auto pastCorner = [&](const Point& p, const Eigen::Vector3d& beam, const Candidate& a, const Candidate& b) {
+    const Point q = p + a.meets * beam;
+    const int side = sides.endsAt(a.slot, b.slot, q);
+    return side != 0 && side * (fitted[b.slot].normal.dot(q) + fitted[b.slot].offset) > 0.0;
+  };
   // A point left on no patch goes back to its block's where it lies within that patch's
   // own noise (ownNoise: σ of its points within `band` of its plane), beyond the map's
   // that capped the tolerance: a wall seen far off by a depth camera lies in layers
@@ -350,8 +359,10 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     if (found > 1 && std::any_of(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within))
       found = static_cast<std::size_t>(std::partition(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within) -
                                        candidates.begin());
-    std::uint32_t chosen = likeliest(std::span(candidates.data(), found), fitted, beam,
-                                     [&](const Candidate& c) { return onPatch(points[index], beam, c); });
+    std::uint32_t chosen = likeliest(
+        std::span(candidates.data(), found), fitted, beam,
+        [&](const Candidate& c) { return onPatch(points[index], beam, c); },
+        [&](const Candidate& a, const Candidate& b) { return pastCorner(points[index], beam, a, b); });
     if (!beam.isZero() && found == 1)
       chosen = nearerAlongBeam(candidates[0], std::span(tail.data(), tail_found), fitted, along_tolerance,
                                kTailTolerances);
