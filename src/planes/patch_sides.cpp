@@ -13,8 +13,9 @@ namespace {
 constexpr std::size_t kSidesSample = 20000;
 
 // Along a stretch of the edge a patch's points "do not reach" a side of the other's plane
-// where at most this share of them there (on its own plane) lie beyond that plane's
-// tolerance: the corner's noise (a normal tail holds 0.13 % past 3σ) and the odd point of
+// where at most this share of them there (on its own plane) lie beyond that plane's σ:
+// room for the corner's noise tail (a stretch holds the patch's points across its whole
+// width, those within a σ or two of the edge a few percent of them) and the odd point of
 // the other surface; and they lie on the other side where half of them lie past it there.
 constexpr double kStrayShare = 0.01;
 constexpr double kBodyShare = 0.5;
@@ -23,12 +24,11 @@ constexpr std::size_t kMinStretchPoints = 3;
 
 std::uint64_t keyOf(std::uint32_t a, std::uint32_t b) { return (static_cast<std::uint64_t>(a) << 32) | b; }
 
-// The side of the plane that values (signed distances) stay off: +1 where at most
-// kStrayShare lie above `tolerance` and at least kBodyShare below -`tolerance`, -1 the
-// mirror, else 0.
+// The side of a plane that a stretch's points stay off (+1: none but strays above, half or
+// more below; -1 the mirror), else 0.
 int sideOff(std::size_t above, std::size_t below, std::size_t all) {
-  const auto share = [all](std::size_t c) { return static_cast<double>(c) / static_cast<double>(all); };
   if (all < kMinStretchPoints) return 0;
+  const auto share = [all](std::size_t c) { return static_cast<double>(c) / static_cast<double>(all); };
   if (share(above) <= kStrayShare && share(below) >= kBodyShare) return 1;
   if (share(below) <= kStrayShare && share(above) >= kBodyShare) return -1;
   return 0;
@@ -38,7 +38,7 @@ int sideOff(std::size_t above, std::size_t below, std::size_t all) {
 
 PatchSides::PatchSides(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
                        const std::vector<PointPlane>& fitted, const OutlineReach& outline, double parallel_cosine,
-                       double cell)
+                       double cell, double sigmas)
     : stretch_(cell) {
   const std::size_t slots = fitted.size();
   std::vector<std::size_t> count(slots, 0);
@@ -63,7 +63,7 @@ PatchSides::PatchSides(std::span<const Point> points, std::span<const std::uint3
 #pragma omp parallel for schedule(dynamic, 16)
   for (std::int64_t k = 0; k < total; ++k) {
     const auto [a, b] = pairs[static_cast<std::size_t>(k)];
-    if (a >= slots || b >= slots || on_plane[a].empty() || !(cell > 0.0)) continue;
+    if (a >= slots || b >= slots || on_plane[a].empty() || !(cell > 0.0) || !(sigmas > 0.0)) continue;
     const PointPlane& edge = fitted[b];
     if (std::abs(edge.normal.dot(fitted[a].normal)) >= parallel_cosine) continue;
     // The outline first: it stays within b's tolerance and a cell's diagonal on one side
@@ -90,13 +90,14 @@ PatchSides::PatchSides(std::span<const Point> points, std::span<const std::uint3
     }
     const auto stretches = static_cast<std::size_t>(std::floor((high - low) / cell)) + 1;
     out.start = low;
+    const double sigma = edge.tolerance / sigmas;
     std::vector<std::size_t> above(stretches, 0), below(stretches, 0), all(stretches, 0);
     for (const Point& p : on_plane[a]) {
       const auto at = std::min(stretches - 1, static_cast<std::size_t>((out.along.dot(p) - low) / cell));
       const double distance = edge.normal.dot(p) + edge.offset;
       ++all[at];
-      above[at] += distance > edge.tolerance ? 1 : 0;
-      below[at] += distance < -edge.tolerance ? 1 : 0;
+      above[at] += distance > sigma ? 1 : 0;
+      below[at] += distance < -sigma ? 1 : 0;
     }
     out.side.assign(stretches, 0);
     for (std::size_t s = 0; s < stretches; ++s)

@@ -21,20 +21,21 @@ class PatchSides {
  public:
   // The pairs of patches `outline` knows (near each other); parallel ones (cosine of their
   // normals at least `parallel_cosine`) are left out. `slot_of_point`: each point's patch
-  // (0: none), best the points on one patch alone. `cell`: the map's cell size (m), which
-  // is also the length of the stretches of an edge its sides are judged on.
+  // (0: none). `cell`: the map's cell size (m), also the length of the stretches of an edge
+  // its sides are judged on. `sigmas`: the planes' tolerances in σ (a point lies past a
+  // plane beyond its σ).
   PatchSides(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
-             const std::vector<PointPlane>& fitted, const OutlineReach& outline, double parallel_cosine,
-             double cell);
+             const std::vector<PointPlane>& fitted, const OutlineReach& outline, double parallel_cosine, double cell,
+             double sigmas);
   // The side of b's plane that patch a does not reach (+1: the side b's normal points to,
-  // -1 the other) along the stretch of their edge where `at` lies; 0 where it does reach
-  // both there or nothing tells.
+  // -1 the other) along the stretch of their edge where `at` lies; 0 where it reaches both
+  // there or nothing tells.
   int endsAt(std::uint32_t a, std::uint32_t b, const Point& at) const;
 
  private:
   struct Edge {
-    Eigen::Vector3d along;        // unit, along the line where the planes meet
-    double start = 0.0;           // along · p where the first stretch begins
+    Eigen::Vector3d along;          // unit, along the line where the planes meet
+    double start = 0.0;             // along · p where the first stretch begins
     std::vector<std::int8_t> side;  // per stretch
   };
   double stretch_;

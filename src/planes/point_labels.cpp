@@ -315,18 +315,32 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
             return true;
     return false;
   };
-  // Whether the beam meets a's plane past b's where a's patch ends at b's plane (likeliest;
-  // PatchSides says where a patch ends, from its outline and from its points on it alone):
-  // past it by more than b's σ (its tolerance over `sigmas`). A plane whose blocks hold the
-  // edge of the surface it meets leans: a simulated stair tread's fit tilted 3° by its
-  // riser, and the riser's points a few mm past it went to the tread (bench/planes_sweep.py's
-  // corridor at 0.05 m: precision 1.00 -> 0.89, its treads each touching a riser).
-  const PatchSides sides(points, sole, fitted, outline_reach, kEdgeCosine, reach);
-  const auto pastCorner = [&](const Point& p, const Eigen::Vector3d& beam, const Candidate& a, const Candidate& b) {
-    const Point q = p + a.meets * beam;
-    const int side = sides.endsAt(a.slot, b.slot, q);
+  // Whether the beam meets a's plane past b's, at a room's inside corner (likeliest): each
+  // patch ends at the other's plane on the scanner's side of it (PatchSides, from the
+  // outline and from the points on it alone or else of its blocks), as a wall and the
+  // ceiling do, and the beam meets a's plane beyond b's by more than b's σ. At a convex edge
+  // (a table top and the face below its rim, a tread's nosing) the faces are small and their
+  // planes leaned a few degrees by the edge blocks they share: the plane of a simulated
+  // table's rim, or a stair tread's tilted 3° by its riser, put the other's points past it
+  // (bench/planes_sweep.py: the lab's tops and the corridor's treads each touched a false
+  // patch, F1 0.9475 -> 0.9339), so the larger patch keeps the edge there as before.
+  std::vector<std::uint32_t> side_slot(heights_wanted ? points.size() : 0);
+  for (std::size_t k = 0; k < side_slot.size(); ++k) side_slot[k] = sole[k] != 0 ? sole[k] : slot_of_point[k];
+  const PatchSides sides(points, side_slot, fitted, outline_reach, kEdgeCosine, reach, options.sigmas);
+  const auto pastCorner = [&](std::size_t index, const Eigen::Vector3d& beam, const Candidate& a,
+                              const Candidate& b) {
+    const Point q = points[index] + a.meets * beam;
+    const PointPlane& own = fitted[a.slot];
     const PointPlane& edge = fitted[b.slot];
-    return side != 0 && side * (edge.normal.dot(q) + edge.offset) > edge.tolerance / options.sigmas;
+    const int a_side = sides.endsAt(a.slot, b.slot, q), b_side = sides.endsAt(b.slot, a.slot, q);
+    if (a_side == 0 || b_side == 0) return false;
+    // Inside: the side of b's plane that a lies on (-a_side) is the scanner's, and the
+    // side of a's plane that b lies on.
+    const Point& scanner = beams.origins[beams.origin_of_point[index]];
+    if (a_side * (edge.normal.dot(scanner) + edge.offset) >= 0.0 ||
+        b_side * (own.normal.dot(scanner) + own.offset) >= 0.0)
+      return false;
+    return a_side * (edge.normal.dot(q) + edge.offset) > edge.tolerance / options.sigmas;
   };
   // A point left on no patch goes back to its block's where it lies within that patch's
   // own noise (ownNoise: σ of its points within `band` of its plane), beyond the map's
@@ -364,10 +378,24 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     if (found > 1 && std::any_of(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within))
       found = static_cast<std::size_t>(std::partition(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within) -
                                        candidates.begin());
+    // A surface returns a beam from its front only: with the scanner known, a candidate
+    // seen from the other side of its plane (seenFrom: its points' scanners) gives way to
+    // one that faces it. The simulated lab's crate: a point on its top by a corner, seen
+    // from the far side, went to a back side's patch by the rules below.
+    if (found > 1 && !beams.origin_of_point.empty()) {
+      const Point& scanner = beams.origins[beams.origin_of_point[index]];
+      const auto facing = [&](const Candidate& c) {
+        return seen_from[c.slot] == 0 || (fitted[c.slot].normal.dot(scanner) + fitted[c.slot].offset) * seen_from[c.slot] > 0.0;
+      };
+      if (std::any_of(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), facing))
+        found = static_cast<std::size_t>(
+            std::partition(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), facing) -
+            candidates.begin());
+    }
     std::uint32_t chosen = likeliest(
         std::span(candidates.data(), found), fitted, beam,
         [&](const Candidate& c) { return onPatch(points[index], beam, c); },
-        [&](const Candidate& a, const Candidate& b) { return pastCorner(points[index], beam, a, b); });
+        [&](const Candidate& a, const Candidate& b) { return pastCorner(index, beam, a, b); });
     if (!beam.isZero() && found == 1)
       chosen = nearerAlongBeam(candidates[0], std::span(tail.data(), tail_found), fitted, along_tolerance,
                                kTailTolerances);
