@@ -365,6 +365,23 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     std::array<Candidate, kMaxCandidates> candidates, tail;
     std::size_t tail_found = 0;
     std::size_t found = gather(index, beam, candidates, &tail, &tail_found);
+    // A surface returns a beam from its front only: with the scanner known, the patches seen
+    // from the other side of their planes (seenFrom: their points' scanners) give way where
+    // one faces it. A cabinet seen from two corners: its top's points by the far edges went
+    // to the far sides' larger patches (tests/test_point_labels_corner.cpp: 28 % kept).
+    if (found > 0 && !beams.origin_of_point.empty()) {
+      const Point& scanner = beams.origins[beams.origin_of_point[index]];
+      const auto facing = [&](const Candidate& c) {
+        const double side = fitted[c.slot].normal.dot(scanner) + fitted[c.slot].offset;
+        return seen_from[c.slot] == 0 || side * seen_from[c.slot] > 0.0;
+      };
+      const auto facing_end = std::stable_partition(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), facing);
+      if (facing_end != candidates.begin()) {
+        found = static_cast<std::size_t>(facing_end - candidates.begin());
+        tail_found = static_cast<std::size_t>(
+            std::stable_partition(tail.begin(), tail.begin() + static_cast<std::ptrdiff_t>(tail_found), facing) - tail.begin());
+      }
+    }
     // Every patch near the point, before the beam's range narrows them (behindEdge).
     std::array<Candidate, 2 * kMaxCandidates> near;
     std::copy_n(candidates.begin(), found, near.begin());
@@ -378,20 +395,6 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     if (found > 1 && std::any_of(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within))
       found = static_cast<std::size_t>(std::partition(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), within) -
                                        candidates.begin());
-    // A surface returns a beam from its front only: with the scanner known, a candidate
-    // seen from the other side of its plane (seenFrom: its points' scanners) gives way to
-    // one that faces it. The simulated lab's crate: a point on its top by a corner, seen
-    // from the far side, went to a back side's patch by the rules below.
-    if (found > 1 && !beams.origin_of_point.empty()) {
-      const Point& scanner = beams.origins[beams.origin_of_point[index]];
-      const auto facing = [&](const Candidate& c) {
-        return seen_from[c.slot] == 0 || (fitted[c.slot].normal.dot(scanner) + fitted[c.slot].offset) * seen_from[c.slot] > 0.0;
-      };
-      if (std::any_of(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), facing))
-        found = static_cast<std::size_t>(
-            std::partition(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), facing) -
-            candidates.begin());
-    }
     std::uint32_t chosen = likeliest(
         std::span(candidates.data(), found), fitted, beam,
         [&](const Candidate& c) { return onPatch(points[index], beam, c); },
