@@ -196,8 +196,9 @@ TEST_CASE("Point labels: a table top keeps its rim over a panel set back under i
   REQUIRE(rim > 100);
   const double share = static_cast<double>(rim_on_top) / static_cast<double>(rim);
   MESSAGE("the top's points over the panel's plane on the top: " << share * 100 << " % of " << rim);
-  // With the outline alone as the corner's witness, the top "ended" at the panel's plane
-  // and the panel took the top's points within its tolerance: 64.5 % of them on the top.
+  // A convex edge: the corner rule must not apply. A version that judged where a patch ends
+  // by its outline alone (cell corners: the top "ended" at the panel's plane) gave the panel
+  // the top's points within its tolerance: 64.5 % of them on the top.
   CHECK(share > 0.95);
 }
 

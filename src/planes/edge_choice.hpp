@@ -171,14 +171,14 @@ std::vector<std::int8_t> seenFrom(std::span<const Point> points, std::span<const
 // degree or counted a cell past the crate's end.
 // With a beam, a plane counts only where the beam meets it on its patch (`on_patch`):
 // past a cabinet's top its side's plane is air.
-// Where both planes' patches are there (`on_patch`), the corner decides if it can: a patch
-// that ends at the other's plane (its outline and its points stay on one side of it,
-// PatchSides) is not where its beam meets it past that plane (`past_corner(a, b)`: a's
-// meeting point lies beyond b's plane on the side a does not reach). At a wall's top under a ceiling the beam meets
-// the wall's plane below the ceiling or the ceiling's beyond the wall, never both: the
-// planes' positions decide, not the range noise, so the point is the one surface's however
-// much larger the other is (PCL's room_scan2 at 0.05 m: 122 of a wall's 2,226 points, some
-// 0.4 cm from its plane and 6 cm from the ceiling's, went to the ceiling by size).
+// Where both planes' patches are there (`on_patch`), an inside corner decides first: a
+// patch that ends at the other's plane is not where its beam meets it past that plane
+// (`past_corner(a, b)`; refinePointLabels asks it at a room's inside corners only). At a
+// wall's top under a ceiling the beam meets the wall's plane below the ceiling or the
+// ceiling's beyond the wall, never both: the planes' positions decide, not the range noise,
+// so the point is the one surface's however much larger the other is (PCL's room_scan2 at
+// 0.05 m: 122 of a wall's 2,226 points, some 0.4 cm from its plane and 6 cm from the
+// ceiling's, went to the ceiling by size).
 template <typename OnPatch, typename PastCorner>
 std::uint32_t likeliest(std::span<const Candidate> candidates, const std::vector<PointPlane>& fitted,
                         const Eigen::Vector3d& beam, OnPatch&& on_patch, PastCorner&& past_corner) {

@@ -375,11 +375,16 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
         const double side = fitted[c.slot].normal.dot(scanner) + fitted[c.slot].offset;
         return seen_from[c.slot] == 0 || side * seen_from[c.slot] > 0.0;
       };
-      const auto facing_end = std::stable_partition(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), facing);
-      if (facing_end != candidates.begin()) {
-        found = static_cast<std::size_t>(facing_end - candidates.begin());
-        tail_found = static_cast<std::size_t>(
-            std::stable_partition(tail.begin(), tail.begin() + static_cast<std::ptrdiff_t>(tail_found), facing) - tail.begin());
+      // In place, in order (the collecting block's patch stays first), no allocation.
+      const auto keepFacing = [&](std::array<Candidate, kMaxCandidates>& list, std::size_t count) {
+        std::size_t kept = 0;
+        for (std::size_t c = 0; c < count; ++c)
+          if (facing(list[c])) list[kept++] = list[c];
+        return kept;
+      };
+      if (std::any_of(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(found), facing)) {
+        found = keepFacing(candidates, found);
+        tail_found = keepFacing(tail, tail_found);
       }
     }
     // Every patch near the point, before the beam's range narrows them (behindEdge).
