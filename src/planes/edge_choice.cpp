@@ -110,13 +110,13 @@ OutlineReach::OutlineReach(const std::vector<const std::vector<Eigen::Vector3d>*
         least = std::min(least, distance);
         greatest = std::max(greatest, distance);
       }
-      reach_.emplace((static_cast<std::uint64_t>(a) << 32) | b, std::pair{least, greatest});
+      reach_.emplace(pairKey(a, b), std::pair{least, greatest});
     }
   }
 }
 
 std::optional<std::pair<double, double>> OutlineReach::of(std::uint32_t a, std::uint32_t b) const {
-  const auto found = reach_.find((static_cast<std::uint64_t>(a) << 32) | b);
+  const auto found = reach_.find(pairKey(a, b));
   if (found == reach_.end()) return std::nullopt;
   return std::pair<double, double>{found->second.first, found->second.second};
 }

@@ -67,6 +67,9 @@ std::vector<HeightRange> patchHeights(std::span<const Point> points, std::span<c
 // How far each patch's outline reaches to either side of the refitted planes of the
 // patches round it: the least and the greatest signed distance of its vertices from the
 // other's plane, for every pair of patches whose outlines' boxes lie within `near`.
+// One key for an ordered pair of patch slots (OutlineReach, PatchSides).
+inline std::uint64_t pairKey(std::uint32_t a, std::uint32_t b) { return (static_cast<std::uint64_t>(a) << 32) | b; }
+
 class OutlineReach {
  public:
   OutlineReach(const std::vector<const std::vector<Eigen::Vector3d>*>& outline_of_slot,

@@ -31,22 +31,13 @@ void fitLabelledPlane(const PcaSums& moments, const Eigen::Vector3d& origin, con
 
 std::vector<double> ownNoise(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
                              const std::vector<PointPlane>& planes, double band) {
-  // Every k-th point of a patch with more than kOwnNoiseSample of them (k from its count):
-  // a median of that many is within a percent or two, and a cloud of tens of millions of
-  // points needs no copy of their distances.
-  constexpr std::size_t kOwnNoiseSample = 20000;
-  std::vector<std::size_t> count(planes.size(), 0);
-  for (const std::uint32_t slot : slot_of_point) ++count[slot];
-  std::vector<std::size_t> seen(planes.size(), 0);
   std::vector<std::vector<float>> distances(planes.size());
-  for (std::size_t index = 0; index < points.size(); ++index) {
-    const std::uint32_t slot = slot_of_point[index];
-    if (slot == 0 || seen[slot]++ % std::max<std::size_t>(1, count[slot] / kOwnNoiseSample) != 0) continue;
+  forSampledPoints(slot_of_point, planes.size(), kPatchSample, [&](std::size_t index, std::uint32_t slot) {
     const PointPlane& plane = planes[slot];
     const double distance = plane.normal.dot(points[index]) + plane.offset;
-    if (!std::isfinite(distance)) continue;  // a non-finite point says nothing of the noise
+    if (!std::isfinite(distance)) return;  // a non-finite point says nothing of the noise
     if (band == 0.0 || std::abs(distance) <= band) distances[slot].push_back(static_cast<float>(distance));
-  }
+  });
   std::vector<double> sigma(planes.size(), 0.0);
   for (std::size_t slot = 1; slot < planes.size(); ++slot) {
     std::vector<float>& values = distances[slot];

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -43,6 +45,28 @@ std::vector<PcaSums> labelledMoments(std::span<const Point> points, std::span<co
   for (const auto& moments : per_chunk)
     for (std::size_t slot = 0; slot < slots; ++slot) total[slot].addShifted(moments[slot], Eigen::Vector3d::Zero());
   return total;
+}
+
+// At most this many points of a patch for its robust statistics (ownNoise, PatchSides): a
+// median or a share of that many is within a percent or two, and a cloud of tens of
+// millions of points needs no copy of them.
+inline constexpr std::size_t kPatchSample = 20000;
+
+// `visit(index, slot)` for every k-th point of each patch (slot_of_point; 0: none, and
+// slots from `slots` on are ignored), k from its count so that at most `sample` of them
+// come, in index order.
+template <typename Visit>
+void forSampledPoints(std::span<const std::uint32_t> slot_of_point, std::size_t slots, std::size_t sample,
+                      Visit&& visit) {
+  std::vector<std::size_t> count(slots, 0);
+  for (const std::uint32_t slot : slot_of_point)
+    if (slot < slots) ++count[slot];
+  std::vector<std::size_t> seen(slots, 0);
+  for (std::size_t index = 0; index < slot_of_point.size(); ++index) {
+    const std::uint32_t slot = slot_of_point[index];
+    if (slot == 0 || slot >= slots || seen[slot]++ % std::max<std::size_t>(1, count[slot] / sample) != 0) continue;
+    visit(index, slot);
+  }
 }
 
 // The least-squares plane of the moments, its tolerance from the points' RMS distance;

@@ -5,12 +5,10 @@
 #include <cstddef>
 #include <limits>
 
+#include "label_fits.hpp"
+
 namespace mlmap {
 namespace {
-
-// Every k-th point of a patch with more than this many (k from its count), as ownNoise
-// takes them.
-constexpr std::size_t kSidesSample = 20000;
 
 // Along a stretch of the edge a patch's points "do not reach" a side of the other's plane
 // where at most this share of them there (on its own plane) lie beyond that plane's σ:
@@ -21,8 +19,6 @@ constexpr double kStrayShare = 0.01;
 constexpr double kBodyShare = 0.5;
 // Fewer points than this on a stretch tell nothing.
 constexpr std::size_t kMinStretchPoints = 3;
-
-std::uint64_t keyOf(std::uint32_t a, std::uint32_t b) { return (static_cast<std::uint64_t>(a) << 32) | b; }
 
 // The side of a plane that a stretch's points stay off (+1: none but strays above, half or
 // more below; -1 the mirror), else 0.
@@ -41,22 +37,15 @@ PatchSides::PatchSides(std::span<const Point> points, std::span<const std::uint3
                        double cell, double sigmas)
     : stretch_(cell) {
   const std::size_t slots = fitted.size();
-  std::vector<std::size_t> count(slots, 0);
-  for (const std::uint32_t slot : slot_of_point)
-    if (slot < slots) ++count[slot];
   // Each patch's sampled points that lie on its own plane (within its tolerance); none
   // where the slots are not given (a cloud without scanners).
-  std::vector<std::size_t> seen(slots, 0);
   std::vector<std::vector<Point>> on_plane(slots);
-  const std::size_t known = std::min(points.size(), slot_of_point.size());
-  for (std::size_t index = 0; index < known; ++index) {
-    const std::uint32_t slot = slot_of_point[index];
-    if (slot == 0 || slot >= slots || seen[slot]++ % std::max<std::size_t>(1, count[slot] / kSidesSample) != 0)
-      continue;
-    const PointPlane& plane = fitted[slot];
-    const double distance = plane.normal.dot(points[index]) + plane.offset;
-    if (std::abs(distance) <= plane.tolerance) on_plane[slot].push_back(points[index]);  // NaN fails
-  }
+  forSampledPoints(slot_of_point.first(std::min(points.size(), slot_of_point.size())), slots, kPatchSample,
+                   [&](std::size_t index, std::uint32_t slot) {
+                     const PointPlane& plane = fitted[slot];
+                     const double distance = plane.normal.dot(points[index]) + plane.offset;
+                     if (std::abs(distance) <= plane.tolerance) on_plane[slot].push_back(points[index]);  // NaN fails
+                   });
   const std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs = outline.pairs();
   std::vector<Edge> edges(pairs.size());
   const auto total = static_cast<std::int64_t>(pairs.size());
@@ -105,11 +94,11 @@ PatchSides::PatchSides(std::span<const Point> points, std::span<const std::uint3
   }
   for (std::size_t k = 0; k < pairs.size(); ++k)
     if (std::any_of(edges[k].side.begin(), edges[k].side.end(), [](std::int8_t s) { return s != 0; }))
-      edges_.emplace(keyOf(pairs[k].first, pairs[k].second), std::move(edges[k]));
+      edges_.emplace(pairKey(pairs[k].first, pairs[k].second), std::move(edges[k]));
 }
 
 int PatchSides::endsAt(std::uint32_t a, std::uint32_t b, const Point& at) const {
-  const auto found = edges_.find(keyOf(a, b));
+  const auto found = edges_.find(pairKey(a, b));
   if (found == edges_.end()) return 0;
   const Edge& edge = found->second;
   const double position = (edge.along.dot(at) - edge.start) / stretch_;
