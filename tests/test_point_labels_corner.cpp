@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <utility>
 
 #include "mlmap/planes/ermsm.hpp"
 #include "mlmap/planes/point_labels.hpp"
@@ -15,38 +16,31 @@ using namespace mlmap;
 
 namespace {
 
-enum Surface : std::uint8_t { kFloor, kCeiling, kWall };
-
-// A 4 x 4 m room, 2.6 m high, closed by one wall at x = 4, seen from (2, 2, 1.2) with 1 cm
-// of range noise along each beam; the floor and the ceiling sampled more densely than the
-// wall (a scanner's points crowd on the surfaces near it), mapped at 5 cm.
-struct Room {
-  static constexpr double kHeight = 2.6;
-  static constexpr double kWallX = 4.0;
-  MLMap map{0.05};
+// Points measured from scanners with 1 cm of range noise along each beam, each with the
+// surface (a small integer) it was measured on; the planes detected on their map, and
+// every point labelled with its scanner's beam.
+struct Scanned {
+  MLMap map;
   std::vector<Point> points;
-  std::vector<Surface> truth;
-  std::vector<Point> scanners{Point(2.0, 2.0, 1.2)};
+  std::vector<std::uint8_t> truth;
+  std::vector<Point> scanners;
   std::vector<std::uint32_t> scanner_of_point;
   PlaneDetection detection;
+  std::mt19937 random;
+  std::normal_distribution<double> range_noise{0.0, 0.01};
 
-  Room() {
-    std::mt19937 random(5);
-    std::normal_distribution<double> range_noise(0.0, 0.01);
-    const auto add = [&](const Point& on_surface, Surface surface) {
-      const Eigen::Vector3d ray = on_surface - scanners[0];
-      const double range = ray.norm() + range_noise(random);
-      points.push_back(scanners[0] + range * ray.normalized());
-      truth.push_back(surface);
-      scanner_of_point.push_back(0);
-    };
-    for (double x = 0.0075; x < kWallX; x += 0.015)
-      for (double y = 0.0075; y < 4.0; y += 0.015) {
-        add(Point(x, y, 0.0), kFloor);
-        add(Point(x, y, kHeight), kCeiling);
-      }
-    for (double y = 0.01; y < 4.0; y += 0.02)
-      for (double z = 0.01; z < kHeight; z += 0.02) add(Point(kWallX, y, z), kWall);
+  Scanned(double cell, std::vector<Point> from, unsigned seed) : map(cell), scanners(std::move(from)), random(seed) {}
+
+  // The return of a beam from `scanner` to a point on a surface.
+  void add(std::uint32_t scanner, const Point& on_surface, std::uint8_t surface) {
+    const Eigen::Vector3d ray = on_surface - scanners[scanner];
+    const double range = ray.norm() + range_noise(random);
+    points.push_back(scanners[scanner] + range * ray.normalized());
+    truth.push_back(surface);
+    scanner_of_point.push_back(scanner);
+  }
+
+  void detect() {
     for (const Point& p : points) map.insert(p, 1e-4);
     detection = detectPlanes(map);
   }
@@ -62,8 +56,8 @@ struct Room {
     return labels;
   }
 
-  // The patch holding most of a surface's points.
-  std::int32_t patchOf(const std::vector<std::int32_t>& labels, Surface surface) const {
+  // The patch holding most of a surface's points (0: none).
+  std::int32_t patchOf(const std::vector<std::int32_t>& labels, std::uint8_t surface) const {
     std::map<std::int32_t, std::size_t> count;
     for (std::size_t k = 0; k < labels.size(); ++k)
       if (truth[k] == surface && labels[k] > 0) ++count[labels[k]];
@@ -72,20 +66,42 @@ struct Room {
       if (best == 0 || n > count[best]) best = id;
     return best;
   }
+
+  // Of a surface's points k that `pick(k)` takes, the share that carry `id`, and how many
+  // were taken.
+  template <typename Pick>
+  std::pair<double, std::size_t> shareOn(const std::vector<std::int32_t>& labels, std::uint8_t surface,
+                                         std::int32_t id, Pick&& pick) const {
+    std::size_t all = 0, on = 0;
+    for (std::size_t k = 0; k < labels.size(); ++k) {
+      if (truth[k] != surface || !pick(k)) continue;
+      ++all;
+      on += labels[k] == id ? 1 : 0;
+    }
+    return {all == 0 ? 0.0 : static_cast<double>(on) / static_cast<double>(all), all};
+  }
 };
 
-// The share of a surface's points within `band` of a place (`near`) that carry `id`.
-template <typename Near>
-double shareOn(const Room& room, const std::vector<std::int32_t>& labels, Surface surface, std::int32_t id,
-               Near&& near) {
-  std::size_t all = 0, on = 0;
-  for (std::size_t k = 0; k < labels.size(); ++k) {
-    if (room.truth[k] != surface || !near(room.points[k])) continue;
-    ++all;
-    on += labels[k] == id ? 1 : 0;
+enum Surface : std::uint8_t { kFloor, kCeiling, kWall };
+
+// A 4 x 4 m room, 2.6 m high, closed by one wall at x = 4, seen from (2, 2, 1.2); the floor
+// and the ceiling sampled more densely than the wall (a scanner's points crowd on the
+// surfaces near it), mapped at 5 cm.
+struct Room : Scanned {
+  static constexpr double kHeight = 2.6;
+  static constexpr double kWallX = 4.0;
+
+  Room() : Scanned(0.05, {Point(2.0, 2.0, 1.2)}, 5) {
+    for (double x = 0.0075; x < kWallX; x += 0.015)
+      for (double y = 0.0075; y < 4.0; y += 0.015) {
+        add(0, Point(x, y, 0.0), kFloor);
+        add(0, Point(x, y, kHeight), kCeiling);
+      }
+    for (double y = 0.01; y < 4.0; y += 0.02)
+      for (double z = 0.01; z < kHeight; z += 0.02) add(0, Point(kWallX, y, z), kWall);
+    detect();
   }
-  return all == 0 ? 0.0 : static_cast<double>(on) / static_cast<double>(all);
-}
+};
 
 }  // namespace
 
@@ -101,12 +117,13 @@ TEST_CASE("Point labels: a wall keeps its top under a larger ceiling and its foo
   REQUIRE(wall != ceiling);
   REQUIRE(wall != floor);
   // The wall's points within 5 cm of each corner (3 cm is the planes' tolerance: 3 σ).
-  const double top = shareOn(room, labels, kWall, wall, [](const Point& p) { return p.z() > Room::kHeight - 0.05; });
-  const double foot = shareOn(room, labels, kWall, wall, [](const Point& p) { return p.z() < 0.05; });
+  const double top =
+      room.shareOn(labels, kWall, wall, [&](std::size_t k) { return room.points[k].z() > Room::kHeight - 0.05; }).first;
+  const double foot = room.shareOn(labels, kWall, wall, [&](std::size_t k) { return room.points[k].z() < 0.05; }).first;
   // And the ceiling's and the floor's within 5 cm of the wall stay theirs.
-  const auto by_wall = [](const Point& p) { return p.x() > Room::kWallX - 0.05; };
-  const double ceiling_by_wall = shareOn(room, labels, kCeiling, ceiling, by_wall);
-  const double floor_by_wall = shareOn(room, labels, kFloor, floor, by_wall);
+  const auto by_wall = [&](std::size_t k) { return room.points[k].x() > Room::kWallX - 0.05; };
+  const double ceiling_by_wall = room.shareOn(labels, kCeiling, ceiling, by_wall).first;
+  const double floor_by_wall = room.shareOn(labels, kFloor, floor, by_wall).first;
   MESSAGE("wall's top on the wall " << top * 100 << " %, its foot " << foot * 100 << " %; the ceiling by the wall "
                                     << ceiling_by_wall * 100 << " %, the floor " << floor_by_wall * 100 << " %");
   // Before, the larger patch took every point within both tolerances: the wall's top 5 cm
@@ -125,44 +142,28 @@ enum Part : std::uint8_t { kTop, kPanel, kGround };
 // from its front edge (x = 2.37), on a floor, seen from (4, 1.6, 1.4) in front of it with
 // 1 cm of range noise, mapped at 10 cm: the top's outline reaches past the panel's plane
 // by less than a cell's diagonal and the planes' tolerance (PCL's office1 at 10 cm).
-struct Overhang {
+struct Overhang : Scanned {
   static constexpr double kTopZ = 0.75;
   static constexpr double kFront = 2.45;
   static constexpr double kPanelX = 2.37;
-  MLMap map{0.1};
-  std::vector<Point> points;
-  std::vector<Part> truth;
-  std::vector<Point> scanners{Point(4.0, 1.6, 1.4)};
-  std::vector<std::uint32_t> scanner_of_point;
-  PlaneDetection detection;
 
-  Overhang() {
-    std::mt19937 random(7);
-    std::normal_distribution<double> range_noise(0.0, 0.01);
-    const auto add = [&](const Point& on_surface, Part part) {
-      const Eigen::Vector3d ray = on_surface - scanners[0];
-      const double range = ray.norm() + range_noise(random);
-      points.push_back(scanners[0] + range * ray.normalized());
-      truth.push_back(part);
-      scanner_of_point.push_back(0);
-    };
+  Overhang() : Scanned(0.1, {Point(4.0, 1.6, 1.4)}, 7) {
     // The height at which the beam to `p` passes the top's front edge: below the top, seen.
     const auto underFront = [&](const Point& p) {
       const double t = (scanners[0].x() - kFront) / (scanners[0].x() - p.x());
       return scanners[0].z() + t * (p.z() - scanners[0].z()) < kTopZ;
     };
     for (double x = 1.0075; x < kFront; x += 0.015)
-      for (double y = 1.0075; y < 2.2; y += 0.015) add(Point(x, y, kTopZ), kTop);
+      for (double y = 1.0075; y < 2.2; y += 0.015) add(0, Point(x, y, kTopZ), kTop);
     for (double y = 1.01; y < 2.2; y += 0.02)
       for (double z = 0.01; z < kTopZ; z += 0.02)
-        if (underFront(Point(kPanelX, y, z))) add(Point(kPanelX, y, z), kPanel);
+        if (underFront(Point(kPanelX, y, z))) add(0, Point(kPanelX, y, z), kPanel);
     for (double x = 0.01; x < 5.0; x += 0.02)
       for (double y = 0.01; y < 3.2; y += 0.02) {
         const bool under_table = x < kFront && y > 1.0 && y < 2.2;
-        if (!under_table || (x > kPanelX && underFront(Point(x, y, 0.0)))) add(Point(x, y, 0.0), kGround);
+        if (!under_table || (x > kPanelX && underFront(Point(x, y, 0.0)))) add(0, Point(x, y, 0.0), kGround);
       }
-    for (const Point& p : points) map.insert(p, 1e-4);
-    detection = detectPlanes(map);
+    detect();
   }
 };
 
@@ -170,31 +171,14 @@ struct Overhang {
 
 TEST_CASE("Point labels: a table top keeps its rim over a panel set back under it") {
   const Overhang scene;
-  Scan scan;
-  scan.points = scene.points;
-  std::vector<std::int32_t> labels = labelPoints(scene.map, scan);
-  refinePointLabels(scene.map, scene.detection.planes, scene.points, labels,
-                    PointLabelRefinement{.noise = scene.detection.config.noise,
-                                         .band = scene.detection.config.epsilon + 0.5 * scene.map.cellSize()},
-                    BeamOrigins{scene.scanners, scene.scanner_of_point});
-  std::map<std::int32_t, std::size_t> on;
-  for (std::size_t k = 0; k < labels.size(); ++k)
-    if (scene.truth[k] == kTop && labels[k] > 0) ++on[labels[k]];
-  REQUIRE(!on.empty());
-  std::int32_t top = on.begin()->first;
-  for (const auto& [id, n] : on)
-    if (n > on[top]) top = id;
+  const std::vector<std::int32_t> labels = scene.labels();
+  const std::int32_t top = scene.patchOf(labels, kTop);
+  REQUIRE(top > 0);
   // The top's points over the panel's plane and up to 5 cm past it (its tolerance is 3).
-  std::size_t rim = 0, rim_on_top = 0;
-  for (std::size_t k = 0; k < labels.size(); ++k) {
-    if (scene.truth[k] != kTop || scene.points[k].x() < Overhang::kPanelX - 0.01 ||
-        scene.points[k].x() > Overhang::kPanelX + 0.05)
-      continue;
-    ++rim;
-    rim_on_top += labels[k] == top ? 1 : 0;
-  }
+  const auto [share, rim] = scene.shareOn(labels, kTop, top, [&](std::size_t k) {
+    return scene.points[k].x() >= Overhang::kPanelX - 0.01 && scene.points[k].x() <= Overhang::kPanelX + 0.05;
+  });
   REQUIRE(rim > 100);
-  const double share = static_cast<double>(rim_on_top) / static_cast<double>(rim);
   MESSAGE("the top's points over the panel's plane on the top: " << share * 100 << " % of " << rim);
   // A convex edge: the corner rule must not apply. A version that judged where a patch ends
   // by its outline alone (cell corners: the top "ended" at the panel's plane) gave the panel
@@ -209,24 +193,10 @@ enum Face : std::uint8_t { kCabinetTop, kNearSide, kFarSide, kCabinetFloor };
 // A cabinet 0.6 x 0.5 x 0.9 m on a floor, seen from two scanners at opposite corners, each
 // seeing the top and the two sides that face it, with 1 cm of range noise, mapped at 5 cm.
 // Each side holds more points than the top.
-struct Cabinet {
+struct Cabinet : Scanned {
   static constexpr double kX0 = 1.8, kX1 = 2.4, kY0 = 1.8, kY1 = 2.3, kTop = 0.9;
-  MLMap map{0.05};
-  std::vector<Point> points;
-  std::vector<Face> truth;
-  std::vector<Point> scanners{Point(0.5, 0.5, 1.2), Point(3.7, 3.6, 1.2)};
-  std::vector<std::uint32_t> scanner_of_point;
-  PlaneDetection detection;
 
-  Cabinet() {
-    std::mt19937 random(9);
-    std::normal_distribution<double> range_noise(0.0, 0.01);
-    const auto add = [&](std::uint32_t scanner, const Point& on_surface, Face face) {
-      const Eigen::Vector3d ray = on_surface - scanners[scanner];
-      points.push_back(scanners[scanner] + (ray.norm() + range_noise(random)) * ray.normalized());
-      truth.push_back(face);
-      scanner_of_point.push_back(scanner);
-    };
+  Cabinet() : Scanned(0.05, {Point(0.5, 0.5, 1.2), Point(3.7, 3.6, 1.2)}, 9) {
     for (std::uint32_t s = 0; s < 2; ++s) {
       const bool near = s == 0;  // scanner 0 sees the sides at x0 and y0, scanner 1 those at x1 and y1
       for (double x = kX0 + 0.0075; x < kX1; x += 0.015)
@@ -242,8 +212,7 @@ struct Cabinet {
           if (!under && !(behind && std::hypot(x - 2.1, y - 2.05) < 1.0)) add(s, Point(x, y, 0.0), kCabinetFloor);
         }
     }
-    for (const Point& p : points) map.insert(p, 1e-4);
-    detection = detectPlanes(map);
+    detect();
   }
 };
 
@@ -251,35 +220,18 @@ struct Cabinet {
 
 TEST_CASE("Point labels: a cabinet's top by its far edge stays the top's, not a side its scanner cannot see") {
   const Cabinet scene;
-  Scan scan;
-  scan.points = scene.points;
-  std::vector<std::int32_t> labels = labelPoints(scene.map, scan);
-  refinePointLabels(scene.map, scene.detection.planes, scene.points, labels,
-                    PointLabelRefinement{.noise = scene.detection.config.noise,
-                                         .band = scene.detection.config.epsilon + 0.5 * scene.map.cellSize()},
-                    BeamOrigins{scene.scanners, scene.scanner_of_point});
-  std::map<std::int32_t, std::size_t> on;
-  for (std::size_t k = 0; k < labels.size(); ++k)
-    if (scene.truth[k] == kCabinetTop && labels[k] > 0) ++on[labels[k]];
-  REQUIRE(!on.empty());
-  std::int32_t top = on.begin()->first;
-  for (const auto& [id, n] : on)
-    if (n > on[top]) top = id;
+  const std::vector<std::int32_t> labels = scene.labels();
+  const std::int32_t top = scene.patchOf(labels, kCabinetTop);
+  REQUIRE(top > 0);
   // The top's points within 3 cm of the edges far from the scanner that saw them: there
   // the far sides' planes lie within their tolerance too, and those sides are larger.
-  std::size_t far_edge = 0, far_edge_on_top = 0;
-  for (std::size_t k = 0; k < labels.size(); ++k) {
-    if (scene.truth[k] != kCabinetTop) continue;
+  const auto [share, far_edge] = scene.shareOn(labels, kCabinetTop, top, [&](std::size_t k) {
     const Point& p = scene.points[k];
-    const bool near_scanner = scene.scanner_of_point[k] == 0;
-    const double to_far_edge = near_scanner ? std::min(Cabinet::kX1 - p.x(), Cabinet::kY1 - p.y())
-                                            : std::min(p.x() - Cabinet::kX0, p.y() - Cabinet::kY0);
-    if (to_far_edge > 0.03) continue;
-    ++far_edge;
-    far_edge_on_top += labels[k] == top ? 1 : 0;
-  }
+    const double to_far_edge = scene.scanner_of_point[k] == 0 ? std::min(Cabinet::kX1 - p.x(), Cabinet::kY1 - p.y())
+                                                              : std::min(p.x() - Cabinet::kX0, p.y() - Cabinet::kY0);
+    return to_far_edge <= 0.03;
+  });
   REQUIRE(far_edge > 100);
-  const double share = static_cast<double>(far_edge_on_top) / static_cast<double>(far_edge);
   MESSAGE("the top's points by its far edges on the top: " << share * 100 << " % of " << far_edge);
   CHECK(share > 0.95);
 }
