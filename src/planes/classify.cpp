@@ -26,20 +26,45 @@ Extent extentOf(const Plane& plane) {
   return extent;
 }
 
-// Whether (x, y) lies inside the outline seen from above (even-odd rule), and how far
-// from its boundary.
-bool insideOutline(const std::vector<Eigen::Vector3d>& outline, double x, double y, double& depth) {
+// An outline seen from above, as edges (a, b) in x and y.
+struct OutlineEdge {
+  Eigen::Vector2d a, b;
+};
+
+std::vector<OutlineEdge> edgesOf(const std::vector<Eigen::Vector3d>& outline) {
+  std::vector<OutlineEdge> edges;
+  edges.reserve(outline.size());
+  for (std::size_t k = 0, previous = outline.size() - 1; k < outline.size(); previous = k++) {
+    edges.push_back({outline[k].head<2>(), outline[previous].head<2>()});
+  }
+  return edges;
+}
+
+// The edges that can decide, on the row at y, whether a point lies inside (they cross the
+// row) or within `depth` of the boundary: the others lie more than `depth` away in y alone.
+void edgesNearRow(const std::vector<OutlineEdge>& edges, double y, double depth, std::vector<OutlineEdge>& near) {
+  near.clear();
+  for (const OutlineEdge& edge : edges) {
+    if (std::min(edge.a.y(), edge.b.y()) - depth <= y && y <= std::max(edge.a.y(), edge.b.y()) + depth) {
+      near.push_back(edge);
+    }
+  }
+}
+
+// Whether (x, y) lies inside the outline seen from above (even-odd rule) at least `depth`
+// from its boundary, given the row's edges from edgesNearRow.
+bool deepInside(const std::vector<OutlineEdge>& near, double x, double y, double depth) {
   bool inside = false;
   double nearest = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0, previous = outline.size() - 1; k < outline.size(); previous = k++) {
-    const Eigen::Vector2d a = outline[k].head<2>(), b = outline[previous].head<2>(), p(x, y);
+  const Eigen::Vector2d p(x, y);
+  for (const OutlineEdge& e : near) {
+    const Eigen::Vector2d &a = e.a, &b = e.b;
     if ((a.y() > y) != (b.y() > y) && x < a.x() + (y - a.y()) * (b.x() - a.x()) / (b.y() - a.y())) inside = !inside;
     const Eigen::Vector2d edge = b - a;
     const double t = edge.squaredNorm() > 0.0 ? std::clamp((p - a).dot(edge) / edge.squaredNorm(), 0.0, 1.0) : 0.0;
     nearest = std::min(nearest, (p - a - t * edge).norm());
   }
-  depth = nearest;
-  return inside;
+  return inside && nearest >= depth;
 }
 
 // The share of the smaller of two patches that lies over (or under) the other deeper
@@ -56,13 +81,15 @@ double deepOverlapShare(const Plane& a, const Plane& b, const Extent& extent_a, 
   const double smaller = std::min(a.area, b.area);
   if (!(x1 > x0 && y1 > y0 && smaller > 0.0)) return 0.0;
   const double step = std::max(0.01, std::sqrt((x1 - x0) * (y1 - y0) / kOverlapSamples));
+  const std::vector<OutlineEdge> edges_a = edgesOf(a.outline), edges_b = edgesOf(b.outline);
+  std::vector<OutlineEdge> near_a, near_b;
   std::size_t both = 0;
-  for (double x = x0 + 0.5 * step; x < x1; x += step) {
-    for (double y = y0 + 0.5 * step; y < y1; y += step) {
-      double depth_a = 0.0, depth_b = 0.0;
-      if (insideOutline(a.outline, x, y, depth_a) && depth_a >= depth && insideOutline(b.outline, x, y, depth_b) &&
-          depth_b >= depth)
-        ++both;
+  // Row by row (y outer): each row tests a point against the few edges near it.
+  for (double y = y0 + 0.5 * step; y < y1; y += step) {
+    edgesNearRow(edges_a, y, depth, near_a);
+    edgesNearRow(edges_b, y, depth, near_b);
+    for (double x = x0 + 0.5 * step; x < x1; x += step) {
+      if (deepInside(near_a, x, y, depth) && deepInside(near_b, x, y, depth)) ++both;
     }
   }
   return static_cast<double>(both) * step * step / smaller;
