@@ -60,13 +60,9 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
       },
       [&](std::size_t file) { progress.update(file + 1); });
   progress.finish();
-  // A patch's tolerance is capped by the sensor's noise: where the planes measured σ
-  // (a median over all their blocks, below the noisier surfaces' own), by the larger of
-  // that and what the build assumed.
-  const double cap = std::max(map.planes()->config.noise, map.planes()->stats.prior_noise);
   if (!arguments.block_labels)
     refinePointLabels(map.blocks(), map.planes()->planes, labelled.points, labelled.labels,
-                      PointLabelRefinement{.noise = cap,
+                      PointLabelRefinement{.noise = labelNoiseCap(*map.planes(), !arguments.input.poses.empty()),
                                            .band = map.planes()->config.epsilon + 0.5 * map.blocks().cellSize()},
                       // Without a pose file a scan's frame may be the world's, not its
                       // scanner's: then where its beams started is unknown.

@@ -3,11 +3,13 @@
 // point-cloud tool can use the map's planes.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "mlmap/map/ml_map.hpp"
+#include "mlmap/planes/ermsm.hpp"
 #include "mlmap/planes/plane.hpp"
 
 namespace mlmap {
@@ -23,6 +25,21 @@ struct PointLabelRefinement {
   double band = 0.0;            // m, the first refit takes the points this close to the detected
                                 // plane (e.g. ε + half a cell); 0 = all the patch's points
 };
+
+// The σ that caps a patch's tolerance (PointLabelRefinement::noise) for labels of
+// `detection`'s planes. A cloud without scanners (`from_scanners` false: isotropic noise, as
+// far as anything tells) has the detection's own σ, measured on the map's points where it was
+// not given; capped instead by the 3 cm a build assumes for points without a variance, a
+// tread's points by its riser lay within a leaning riser's 9 cm at 1 cm of noise and went to
+// it (../shared/peers/make_scene.py's rooms, bench/peer_scene.py: mean F1 0.866 / 0.852 ->
+// 0.883 / 0.900 at 0.05 / 0.1 m cells; Bobkov's room and plane_seg's stairs in
+// bench/real_data.py found as before). Scans from scanners keep the larger of that σ and the
+// build's: their range noise lies along the beam, and across surfaces seen at grazing angles
+// it reads low (the simulated lab's 1 cm as 0.40 cm; capped there, bench/planes_sweep.py's
+// F1 fell 0.948 -> 0.928).
+inline double labelNoiseCap(const PlaneDetection& detection, bool from_scanners) {
+  return from_scanners ? std::max(detection.config.noise, detection.stats.prior_noise) : detection.config.noise;
+}
 
 struct PointPlane {  // a patch's plane refitted to its points
   std::int32_t id = 0;      // the patch's id
