@@ -42,6 +42,11 @@ struct SequenceConfig {
   // table top below it and no floor).
   bool level_from_floor = true;
   std::size_t min_floor_points = 500;
+  // Where a scan shows less floor than that, the points of its sample in the densest slab by
+  // the first floor's plane set its height alone (shiftOntoReferenceFloor), from at least this
+  // many: 0.25 m² of floor in the 0.05 m sample, whose median lies within σ / 8 of the floor
+  // (1.25 σ / √n); 0 = never.
+  std::size_t min_reference_floor_points = 100;
   double max_level_turn_deg = 3.0;
   double max_level_shift = 0.1;
   // m, the refinement's sample of each scan (its pairs start from registered poses, and its
@@ -130,6 +135,7 @@ class SequenceRegistration {
   };
   std::optional<Floor> floorOf(const std::vector<Point>& source) const;
   Pose levelledOnFloor(const Pose& pose, const Floor& floor, const std::vector<Point>& source) const;
+  std::optional<double> shiftOntoReferenceFloor(const Pose& pose, const std::vector<Point>& source, double sigma) const;
   std::optional<Floor> reference_floor_;  // the first floor seen, world frame
   std::vector<bool> levelled_;            // per scan: levelled on its floor
   std::vector<Pose> chain_;                  // the scan-to-map poses, before refinement
