@@ -20,6 +20,26 @@ namespace {
 using Flight = test::StairFlight;
 constexpr int kSteps = Flight::kSteps;
 
+// The flight's points labelled as `mlmap label` labels a cloud without poses: each point's
+// patch (by_patch: its truth counts per patch), the planes refitted, and each true surface's
+// point count.
+struct Labelled {
+  std::vector<PointPlane> fitted;
+  test::TruthByPatch by_patch;
+  std::map<std::int32_t, std::size_t> surface_points;
+
+  explicit Labelled(const Flight& flight) {
+    Scan all;
+    all.points = flight.points;
+    std::vector<std::int32_t> labels = labelPoints(flight.map, all);
+    fitted = refinePointLabels(flight.map, flight.detection.planes, flight.points, labels,
+                               PointLabelRefinement{.noise = labelNoiseCap(flight.detection, false),
+                                                    .band = flight.detection.config.epsilon + 0.5 * flight.map.cellSize()});
+    by_patch = test::truthByPatch(labels, flight.truth);
+    for (const std::int32_t surface : flight.truth) ++surface_points[surface];
+  }
+};
+
 }  // namespace
 
 TEST_CASE("Point labels: a riser shorter than two cells is refitted plumb, not leaning onto the treads") {
@@ -29,16 +49,8 @@ TEST_CASE("Point labels: a riser shorter than two cells is refitted plumb, not l
   // plane kept leaning 10-17 deg onto the treads and took 40 % of each tread (the peers'
   // make_scene.py room at 10 cm: 20 of 23 planes matched at 5 mm of noise, 23 now).
   static const Flight flight(0.005, 0.1);
-  Scan all;
-  all.points = flight.points;
-  std::vector<std::int32_t> labels = labelPoints(flight.map, all);
-  const std::vector<PointPlane> fitted =
-      refinePointLabels(flight.map, flight.detection.planes, flight.points, labels,
-                        PointLabelRefinement{.noise = labelNoiseCap(flight.detection, false),
-                                             .band = flight.detection.config.epsilon + 0.5 * flight.map.cellSize()});
-  const test::TruthByPatch by_patch = test::truthByPatch(labels, flight.truth);
-  std::map<std::int32_t, std::size_t> surface_points;
-  for (const std::int32_t surface : flight.truth) ++surface_points[surface];
+  const Labelled labelled(flight);
+  const auto& [fitted, by_patch, surface_points] = labelled;
   int plumb = 0;
   for (int k = 0; k < kSteps; ++k) {
     const std::int32_t riser = Flight::riser(k);
@@ -63,7 +75,7 @@ TEST_CASE("Point labels: a riser shorter than two cells is refitted plumb, not l
     for (const auto& [surface, count] : by_patch.at(best))
       if (surface != riser) others += count;
     MESSAGE("riser " << k << ": patch " << best << " leans " << lean_deg << " deg, holds "
-                     << 100.0 * static_cast<double>(best_count) / static_cast<double>(surface_points[riser])
+                     << 100.0 * static_cast<double>(best_count) / static_cast<double>(surface_points.at(riser))
                      << " % of it and " << others << " other points");
     // Leaning 10-17° it took 40 % of each tread's ~670 points; capped by the measured σ
     // (labelNoiseCap) the band is too thin to turn one riser of five upright again (7°), but
@@ -83,15 +95,8 @@ TEST_CASE("Point labels: with 1 cm of noise measured, the treads keep their stri
   // matched, 22-23 now). The lower two stay below 0.3 either way (a weak spot).
   const Flight flight(0.01, 0.1);
   REQUIRE(flight.detection.stats.prior_noise == doctest::Approx(0.03));  // σ measured, not assumed
-  Scan all;
-  all.points = flight.points;
-  std::vector<std::int32_t> labels = labelPoints(flight.map, all);
-  refinePointLabels(flight.map, flight.detection.planes, flight.points, labels,
-                    PointLabelRefinement{.noise = labelNoiseCap(flight.detection, false),
-                                         .band = flight.detection.config.epsilon + 0.5 * flight.map.cellSize()});
-  const test::TruthByPatch by_patch = test::truthByPatch(labels, flight.truth);
-  std::map<std::int32_t, std::size_t> surface_points;
-  for (const std::int32_t surface : flight.truth) ++surface_points[surface];
+  const Labelled labelled(flight);
+  const auto& [fitted, by_patch, surface_points] = labelled;
   for (int k = 2; k < kSteps; ++k) {
     const std::int32_t tread = Flight::tread(k);
     double best_iou = 0.0;
@@ -101,7 +106,7 @@ TEST_CASE("Point labels: with 1 cm of noise measured, the treads keep their stri
       std::size_t patch_points = 0;
       for (const auto& [surface, count] : by_truth) patch_points += count;
       const double both = static_cast<double>(found->second);
-      best_iou = std::max(best_iou, both / (static_cast<double>(surface_points[tread] + patch_points) - both));
+      best_iou = std::max(best_iou, both / (static_cast<double>(surface_points.at(tread) + patch_points) - both));
     }
     MESSAGE("tread " << k << ": IoU " << best_iou);
     CHECK(best_iou >= 0.66);

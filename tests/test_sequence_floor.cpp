@@ -57,24 +57,38 @@ mlmap::Pose stepError(double x, double y, double z, double roll_deg, double yaw_
   return error;
 }
 
-}  // namespace
+// Room-22's four scans registered from the true trajectory with `errors` added to each
+// odometry step (errors[0] unused), as `mlmap register` does; the true poses beside.
+struct Registered {
+  SequenceRegistration sequence;
+  std::vector<mlmap::Pose> truth;
+};
 
-TEST_CASE("SequenceRegistration: each scan's floor holds the tilt and height that the shared surfaces leave free") {
+Registered registeredRoom(const std::vector<mlmap::Pose>& errors) {
   const auto scans = mlmap::sim::simulate(mlmap::sim::parseScene(kRoomJson, "room-22.json"));
   REQUIRE(scans.size() == 4);
-  const std::vector<mlmap::Pose> errors = {mlmap::Pose::Identity(), stepError(-0.03, 0.034, 0.002, -0.565, -24.982),
-                                           stepError(-0.037, 0.265, -0.087, -0.171, 20.764),
-                                           stepError(0.023, -0.026, 0.003, -0.049, 2.924)};
+  REQUIRE(errors.size() == scans.size());
   SequenceConfig config;
   config.min_range = 0.4;  // as `mlmap register`
-  SequenceRegistration sequence(config);
-  std::vector<mlmap::Pose> truth;
+  Registered run{SequenceRegistration(config), {}};
   mlmap::Pose odometry = scans[0].true_pose;
   for (std::size_t k = 0; k < scans.size(); ++k) {
     if (k > 0) odometry = odometry * (scans[k - 1].true_pose.inverse() * scans[k].true_pose) * errors[k];
-    sequence.addScan(scans[k].scan.points, odometry);
-    truth.push_back(scans[k].true_pose);
+    run.sequence.addScan(scans[k].scan.points, odometry);
+    run.truth.push_back(scans[k].true_pose);
   }
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("SequenceRegistration: each scan's floor holds the tilt and height that the shared surfaces leave free") {
+  const std::vector<mlmap::Pose> errors = {mlmap::Pose::Identity(), stepError(-0.03, 0.034, 0.002, -0.565, -24.982),
+                                           stepError(-0.037, 0.265, -0.087, -0.171, 20.764),
+                                           stepError(0.023, -0.026, 0.003, -0.049, 2.924)};
+  Registered run = registeredRoom(errors);
+  SequenceRegistration& sequence = run.sequence;
+  const std::vector<mlmap::Pose>& truth = run.truth;
   CHECK(sequence.levelledOnFloor(2));  // the scan whose odometry is 9 cm low
   CHECK_FALSE(sequence.levelledOnFloor(0));
   sequence.refine();
@@ -90,21 +104,12 @@ TEST_CASE("SequenceRegistration: a scan with a strip of floor too small for its 
   // scan 1 starts 9.6 cm low, faces a box 1 m off and holds too little floor for
   // calibrateFromFloor (min_floor_points); ICP leaves its height free, 3-4 cm low. Its strip
   // of floor by the first scan's floor plane sets it (shiftOntoReferenceFloor).
-  const auto scans = mlmap::sim::simulate(mlmap::sim::parseScene(kRoomJson, "room-22.json"));
-  REQUIRE(scans.size() == 4);
   const std::vector<mlmap::Pose> errors = {mlmap::Pose::Identity(), stepError(-0.2674, -0.0513, -0.0958, 0.496, 7.634),
                                            stepError(-0.0118, 0.2240, 0.0235, 0.004, 8.044),
                                            stepError(-0.1577, 0.0574, -0.1768, -0.608, -6.007)};
-  SequenceConfig config;
-  config.min_range = 0.4;  // as `mlmap register`
-  SequenceRegistration sequence(config);
-  std::vector<mlmap::Pose> truth;
-  mlmap::Pose odometry = scans[0].true_pose;
-  for (std::size_t k = 0; k < scans.size(); ++k) {
-    if (k > 0) odometry = odometry * (scans[k - 1].true_pose.inverse() * scans[k].true_pose) * errors[k];
-    sequence.addScan(scans[k].scan.points, odometry);
-    truth.push_back(scans[k].true_pose);
-  }
+  Registered run = registeredRoom(errors);
+  SequenceRegistration& sequence = run.sequence;
+  const std::vector<mlmap::Pose>& truth = run.truth;
   sequence.refine();
   const mlmap::Pose& one = sequence.poses()[1];
   const double height_error = (one.translation() - truth[1].translation()).z() -
