@@ -3,10 +3,11 @@
 // from the 6×6 normal equations (Eigen, no Ceres). The adaptive threshold: the
 // correspondence gate shrinks to 3× the residuals' robust spread plus the last step's
 // motion, and the kernel scale is a third of the gate.
-// Two stages: a coarse one on an evenly spread ~1500-point subset of the source with the
+// Stages: a coarse one on an evenly spread ~1500-point subset of the source with the
 // gate held at its initial width until the pose stops moving (the wide searches are the
-// costly ones, and a wide gate is what brings a pose back from decimetres and degrees off),
-// then every point with the adaptive gate. The coarse stage's steps converge linearly; two that
+// costly ones, and a wide gate is what brings a pose back from decimetres and degrees off);
+// where that leaves the adaptive gate wider than twice its floor, a ~3000-point subset
+// follows it until it closes or the pose stops; then every point with the adaptive gate. The coarse stage's steps converge linearly; two that
 // continue each other are extrapolated (the rest of their geometric series at once, within
 // half the gate). Searches are skipped where their answer cannot
 // have changed much: points that found nothing within the gate wait until the pose has moved
