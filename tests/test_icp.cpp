@@ -182,3 +182,24 @@ TEST_CASE("ICP: the coarse stage's passes run on all threads, the same answer at
   CHECK(runs[0].rms_residual == runs[1].rms_residual);
 }
 #endif
+
+TEST_CASE("ICP: from a far start on a dense source the answer comes from every point, not the middle stage's subset") {
+  // A 5 cm down-sampled source holds 11,000 points, several times the middle stage's ~3000.
+  // From 10 deg off the coarse stage settles and the gate closes to its floor at once; from
+  // 28 deg it ends with the gate at 0.93 m, and the middle stage (every third point) steers
+  // until the gate is under 0.2 m. Either way the answer is every point's: a run that stopped
+  // on the subset would count at most a third of them as inliers.
+  Pair pair = simulatedPair(kRoomJson);
+  const auto scans = mlmap::sim::simulate(mlmap::sim::parseScene(kRoomJson, "scene.json"));
+  pair.source = voxelDownSample(scans[1].scan.points, 0.05);
+  REQUIRE(pair.source.size() > 9000);
+  for (const double angle_deg : {10.0, 28.0}) {
+    CAPTURE(angle_deg);
+    const Pose start = perturbed(pair.true_pose, {0.5, -0.2, 0.0}, {0, 0, 1}, angle_deg);
+    const IcpResult result = alignPoints(pair.source, pair.target, start);
+    CHECK(result.converged);
+    CHECK(translationError(result.pose, pair.true_pose) < 0.01);
+    CHECK(rotationErrorDeg(result.pose, pair.true_pose) < 0.1);
+    CHECK(result.inliers > result.source_points / 2);
+  }
+}
