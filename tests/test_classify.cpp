@@ -161,3 +161,33 @@ TEST_CASE("Classes: a table over the chairs' seats, a riser above them, and a si
   classifyPlanes(flight, {}, under_flight);
   for (const Plane& tread : flight) CHECK(tread.label == PlaneClass::Step);
 }
+
+TEST_CASE("Classes: a flight from the floor goes on past a tread that came as a tilted band") {
+  // plane_seg's ANYmal stairs at 10 cm cells: the second tread's patch held the riser below
+  // it and leaned 16.5°; the flight stopped there, and the third tread (0.5 m over the floor)
+  // and the landing above it were 'table'.
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  std::vector<Plane> planes;
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.0}, 0.0, 1.3, 0.0, 1.8));  // 0: floor
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.18}, 1.3, 1.8, 0.0, 1.8));  // 1: tread 1
+  // 2: tread 2 and the riser under it, leaning 16.5° (rising 0.25 m over 0.8 m along x)
+  const double lean = 16.5 * std::numbers::pi / 180.0;
+  planes.push_back(levelPatch(Eigen::Vector3d(-std::sin(lean), 0.0, std::cos(lean)), {2.2, 0.9, 0.36}, 1.8, 2.6, 0.0,
+                              1.8));
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.52}, 2.6, 3.0, 0.0, 1.8));  // 3: tread 3
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.70}, 3.0, 5.0, 0.0, 2.4));  // 4: the landing
+  classifyPlanes(planes);
+  CHECK(planes[0].label == PlaneClass::Floor);
+  CHECK(planes[1].label == PlaneClass::Step);
+  CHECK(planes[2].label == PlaneClass::Step);  // 'other' before
+  CHECK(planes[3].label == PlaneClass::Step);  // 'table' before
+  CHECK(planes[4].label == PlaneClass::Step);  // 'table' before
+
+  // The same band beside a desk, with no flight climbing to it from the floor, is no step.
+  std::vector<Plane> furniture{planes[0], planes[2], planes[3]};
+  furniture[1].centroid.x() += 3.0;
+  for (Eigen::Vector3d& corner : furniture[1].outline) corner.x() += 3.0;
+  furniture[1].offset = -furniture[1].normal.dot(furniture[1].centroid);
+  classifyPlanes(furniture);
+  CHECK(furniture[1].label == PlaneClass::Other);
+}

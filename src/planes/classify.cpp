@@ -187,12 +187,29 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   // floor, a flight is three level patches or more, each a riser from the next: a table
   // top and the one piece a riser below it are no staircase (Bobkov's room 2, a cloud cut
   // above its floor: its table and sideboard tops were steps).
-  auto mayStep = [&](std::size_t k) { return planes[k].label == PlaneClass::Other && belowCeiling(planes[k]); };
+  // Tilted patches low enough for one step's band (a tread and its riser, or a riser and its
+  // nosing, in one patch: stepped.hpp cuts a ramp through a flight into these).
+  std::vector<std::size_t> bands;
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    if (!isLevel(planes[k].normal, config) && !isPlumb(planes[k].normal, config) &&
+        extents[k].max.z() - extents[k].min.z() <= config.riser_max + config.level_tolerance)
+      bands.push_back(k);
+  }
+  // What a flight that climbs from the floor may hold: the level patches and, between them,
+  // such bands. plane_seg's
+  // ANYmal stairs at 10 cm cells: the second tread's patch leans 16.5° (it holds the riser
+  // below it), and the flight from the floor stopped there, so the third tread (0.5 m over
+  // the floor) and the upper landing read as tables.
+  std::vector<std::size_t> steppable = horizontal;
+  steppable.insert(steppable.end(), bands.begin(), bands.end());
+  auto mayStep = [&](std::size_t k) {
+    return (planes[k].label == PlaneClass::Other || !isLevel(planes[k].normal, config)) && belowCeiling(planes[k]);
+  };
   std::vector<std::uint8_t> step(planes.size(), 0);  // 1: a step; 0 and 2: not
-  // Grows a flight from `members` (marked in `step` already) through riser links.
-  auto grow = [&](std::vector<std::size_t>& members) {
+  // Grows a flight from `members` (marked in `step` already) through riser links to `candidates`.
+  auto grow = [&](std::vector<std::size_t>& members, const std::vector<std::size_t>& candidates) {
     for (std::size_t n = 0; n < members.size(); ++n) {
-      for (const std::size_t k : horizontal) {
+      for (const std::size_t k : candidates) {
         if (step[k] == 0 && mayStep(k) && oneStepApart(k, members[n])) {
           step[k] = 1;
           members.push_back(k);
@@ -202,7 +219,7 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   };
   if (floor != nullptr) {
     std::vector<std::size_t> flight;
-    for (const std::size_t k : horizontal) {
+    for (const std::size_t k : steppable) {
       if (!mayStep(k)) continue;
       for (const std::size_t other : horizontal) {
         if (planes[other].label == PlaneClass::Floor && oneStepApart(k, other)) {
@@ -212,13 +229,15 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
         }
       }
     }
-    grow(flight);
+    grow(flight, steppable);
   } else {
+    // Without a floor, level patches only: a band between a table and a seat would make
+    // three (Bobkov's room 2 at 10 cm cells: its table and sideboard tops became steps).
     for (const std::size_t k : horizontal) {
       if (step[k] != 0 || !mayStep(k)) continue;
       std::vector<std::size_t> flight{k};
       step[k] = 1;
-      grow(flight);
+      grow(flight, horizontal);
       // Too short a flight: seen (2), so no later one grows into it, and no step.
       if (flight.size() < 3) {
         for (const std::size_t member : flight) step[member] = 2;
@@ -235,15 +254,8 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
       plane.label = PlaneClass::Table;
     }
   }
-  // Tilted patches low enough for one step's band, a riser apart and side by side, three
-  // or more: a flight seen from below, each step its riser and nosing (stepped.hpp cuts a
-  // ramp through them into these bands).
-  std::vector<std::size_t> bands;
-  for (std::size_t k = 0; k < planes.size(); ++k) {
-    if (!isLevel(planes[k].normal, config) && !isPlumb(planes[k].normal, config) &&
-        extents[k].max.z() - extents[k].min.z() <= config.riser_max + config.level_tolerance)
-      bands.push_back(k);
-  }
+  // Bands a riser apart and side by side, three or more, are a flight too: one seen from
+  // below, each step its riser and nosing.
   std::vector<std::uint8_t> in_flight(planes.size(), 0);
   for (const std::size_t start : bands) {
     if (in_flight[start] != 0) continue;
@@ -266,7 +278,7 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
     Plane& plane = planes[k];
     if (isLevel(plane.normal, config)) continue;
     if (!isPlumb(plane.normal, config)) {
-      plane.label = in_flight[k] == 1 ? PlaneClass::Step : PlaneClass::Other;
+      plane.label = in_flight[k] == 1 || step[k] == 1 ? PlaneClass::Step : PlaneClass::Other;
       continue;
     }
     const double height = extents[k].max.z() - extents[k].min.z();
