@@ -35,11 +35,14 @@ constexpr double kCoarseEigenvalueFactor = 2.0;
 // stage's first passes search at that gate, tens of voxels per search for every point (10-23
 // ms a pass on the stress benchmark's scans of 23,000 points, a quarter of the run's time
 // from large starts). Every so many points (about kMiddlePoints) steer instead until the gate
-// has closed to kDenseGateFactor x its floor, or the pose stops moving (as the coarse stage);
-// then every point refines, and only then may the run reuse matches or converge. Stress
-// benchmark, tuned on the tune split (one thread, CPU over all 126 starts, 2 rounds): 26.8 ->
-// 24.0 s; 0.15 x and 0.12 x the floor, 2000 and 6000 points were within 2 %; the same
-// successes and verdicts on every split (report: 28.7 -> 25.7 s, large starts' median -14 %).
+// has closed to kDenseGateFactor x its floor, the pose stops moving (as the coarse stage) or
+// kMaxCoarseIterations passes went by; then every point refines, and only then may the run
+// reuse matches or converge. Stress benchmark, tuned on the tune split (one thread, CPU over
+// all 126 starts, 2 rounds): 26.8 -> 24.0 s; 1.5 x or 1.2 x the floor and 2000 points within
+// 2 % of that, 6000 points 2.5 % slower. The same successes and verdicts, start by start, on
+// every split (report: 28.7 -> 25.7 s, large starts' median -14 %), and the same sequences
+// (register_ate.py): runs whose gate leaves the coarse stage under 2 x its floor never enter
+// it. (Session 45's middle stage, at every gate, moved corridors along their free axis.)
 constexpr std::size_t kMiddlePoints = 3000;
 constexpr double kDenseGateFactor = 2.0;
 // The coarse stage converges linearly: at the 0.5 m gate its steps shrink by 5-10 % an
