@@ -93,6 +93,23 @@ TEST_CASE("alignVerified: far is not degenerate") {
   CHECK(rotationErrorDeg(result.icp.pose, pair.true_pose) < 0.1);
 }
 
+TEST_CASE("alignVerified: the source's surfaces given once give the same answer as measured per call") {
+  // A sequence's refinement aligns each scan's sample to several neighbours of one voxel size
+  // and measures its normals and noise once (cloudSurfaces), not in every pair.
+  const Pair pair = simulatedPair(kRoomJson);
+  const CloudSurfaces surfaces = cloudSurfaces(pair.source, pair.target.voxelSize());
+  for (const double yaw_deg : {3.0, 10.0}) {
+    CAPTURE(yaw_deg);
+    const Pose start = startOff(pair.true_pose, {0.2, -0.1, 0.0}, yaw_deg);
+    const VerifiedIcp measured = alignVerified(pair.source, pair.target, start);
+    const VerifiedIcp given = alignVerified(pair.source, surfaces, pair.target, start);
+    CHECK(given.verified == measured.verified);
+    CHECK(given.source_noise == measured.source_noise);
+    CHECK(given.icp.pose.matrix() == measured.icp.pose.matrix());
+    CHECK(given.check.explained_share == measured.check.explained_share);
+  }
+}
+
 TEST_CASE("alignVerified: a finely scanned pair with 1 cm noise verifies at the first run") {
   // Down-sampled points average many readings, and the noise they keep shows about their
   // neighbourhood, not within one voxel: the within-voxel spread (0.2 cm here) made the

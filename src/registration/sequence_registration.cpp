@@ -246,6 +246,9 @@ RefinementResult SequenceRegistration::refine() {
   }
   const std::vector<double>& source_noise =
       config_.basin.source_noise > 0.0 ? std::vector<double>(noise.size(), config_.basin.source_noise) : noise;
+  // Each scan's sample as a source, its normals and noise at the locals' voxel size: the same
+  // in every pair it is the source of (cloudSurfaces), measured before its first pair.
+  std::vector<std::optional<CloudSurfaces>> source_surfaces(sources_.size());
   for (int round = 0; round < config_.refinement_rounds; ++round) {
     std::vector<PoseGraphEdge> edges;
     for (std::size_t i = 0; i + 1 < poses_.size(); ++i) {
@@ -276,6 +279,9 @@ RefinementResult SequenceRegistration::refine() {
       neighbours[i].push_back(j);
       neighbours[j].push_back(i);
     }
+    for (const auto& [i, j] : pairs) {
+      if (!source_surfaces[j]) source_surfaces[j] = cloudSurfaces(sources_[j], config_.map_voxel_size);
+    }
     std::vector<VerifiedIcp> pair_results(pairs.size());
     BasinConfig basin = pair_basin;
 #pragma omp parallel for schedule(dynamic, 1) firstprivate(basin)
@@ -284,7 +290,7 @@ RefinementResult SequenceRegistration::refine() {
       basin.noise = noise[i];
       basin.source_noise = source_noise[j];
       pair_results[static_cast<std::size_t>(p)] =
-          alignVerified(sources_[j], locals[i], poses_[i].inverse() * poses_[j], pair_config, basin);
+          alignVerified(sources_[j], *source_surfaces[j], locals[i], poses_[i].inverse() * poses_[j], pair_config, basin);
     }
     result.pair_edges = 0;
     result.loop_edges = 0;

@@ -220,6 +220,12 @@ Verification verifyAlignment(const std::vector<Point>& source, const VoxelHashMa
 
 VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& start,
                           const IcpConfig& icp, const BasinConfig& config) {
+  if (source.empty() || target.empty()) return alignVerified(source, CloudSurfaces{}, target, start, icp, config);
+  return alignVerified(source, cloudSurfaces(source, target.voxelSize()), target, start, icp, config);
+}
+
+VerifiedIcp alignVerified(const std::vector<Point>& source, const CloudSurfaces& surfaces, const VoxelHashMap& target,
+                          const Pose& start, const IcpConfig& icp, const BasinConfig& config) {
   VerifiedIcp out;
   out.start = out.kept_start = start;
   out.icp.pose = start;
@@ -230,7 +236,6 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
   }
   // The expected residual: both clouds carry their measured noise.
   out.noise = config.noise > 0.0 ? config.noise : std::max(config.min_noise, target.surfaceNoise());
-  const CloudSurfaces surfaces = cloudSurfaces(source, target.voxelSize());
   out.source_noise = config.source_noise > 0.0 ? config.source_noise : std::max(config.min_noise, surfaces.noise);
   const double sigma = std::hypot(out.noise, out.source_noise);
   // The verification gate reaches past a misalignment's residuals (so their spread shows)

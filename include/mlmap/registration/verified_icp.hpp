@@ -164,5 +164,11 @@ bool onlyLevelDisagrees(const Verification& check, const BasinConfig& config = {
 // Aligns as above; `icp` sets the ICP itself (its initial_max_distance is a lower bound).
 VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& target, const Pose& start,
                           const IcpConfig& icp = {}, const BasinConfig& config = {});
+// The same with the source's normals and noise given: `surfaces` must be
+// cloudSurfaces(source, target.voxelSize()). A source aligned to several targets of one voxel
+// size (a sequence's pairs) measures them once: on the simulated lab's 8 scans `mlmap register`
+// measured them 24 times, 0.85 s of its 2.6 s.
+VerifiedIcp alignVerified(const std::vector<Point>& source, const CloudSurfaces& surfaces, const VoxelHashMap& target,
+                          const Pose& start, const IcpConfig& icp = {}, const BasinConfig& config = {});
 
 }  // namespace mlmap::registration
