@@ -196,10 +196,9 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
       bands.push_back(k);
   }
   // What a flight that climbs from the floor may hold: the level patches and, between them,
-  // such bands. plane_seg's
-  // ANYmal stairs at 10 cm cells: the second tread's patch leans 16.5° (it holds the riser
-  // below it), and the flight from the floor stopped there, so the third tread (0.5 m over
-  // the floor) and the upper landing read as tables.
+  // such bands. plane_seg's ANYmal stairs at 10 cm cells: the second tread's patch leans 16.5°
+  // (it holds the riser below it), and the flight from the floor stopped there, so the third
+  // tread (0.5 m over the floor) and the upper landing read as tables.
   std::vector<std::size_t> steppable = horizontal;
   steppable.insert(steppable.end(), bands.begin(), bands.end());
   auto mayStep = [&](std::size_t k) {

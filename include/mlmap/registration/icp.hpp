@@ -7,11 +7,11 @@
 // gate held at its initial width until the pose stops moving (the wide searches are the
 // costly ones, and a wide gate is what brings a pose back from decimetres and degrees off);
 // where that leaves the adaptive gate wider than twice its floor, a ~3000-point subset
-// follows it until it closes or the pose stops; then every point with the adaptive gate. The coarse stage's steps converge linearly; two that
-// continue each other are extrapolated (the rest of their geometric series at once, within
-// half the gate). Searches are skipped where their answer cannot
-// have changed much: points that found nothing within the gate wait until the pose has moved
-// a quarter of the gate, and once an iteration moves points by less than 2 mm the
+// follows it until it closes or the pose stops; then every point with the adaptive gate.
+// The coarse stage's steps converge linearly; two that continue each other are
+// extrapolated (the rest of their geometric series at once, within half the gate). Searches
+// are skipped where their answer cannot have changed much: points that found nothing within
+// the gate wait until the pose has moved a quarter of the gate, and once an iteration moves points by less than 2 mm the
 // correspondences are kept and only re-linearised.
 // The result says when it cannot be trusted: too few inliers, or degenerate geometry (a
 // near-zero eigenvalue of the normal equations, e.g. along a featureless corridor).
