@@ -11,8 +11,8 @@
 // The coarse stage's steps converge linearly; two that continue each other are
 // extrapolated (the rest of their geometric series at once, within half the gate). Searches
 // are skipped where their answer cannot have changed much: points that found nothing within
-// the gate wait until the pose has moved a quarter of the gate, and once an iteration moves points by less than 2 mm the
-// correspondences are kept and only re-linearised.
+// the gate wait until the pose has moved a quarter of the gate, and once an iteration moves
+// points by less than 2 mm the correspondences are kept and only re-linearised.
 // The result says when it cannot be trusted: too few inliers, or degenerate geometry (a
 // near-zero eigenvalue of the normal equations, e.g. along a featureless corridor).
 #pragma once
