@@ -58,7 +58,8 @@ struct Pair {
   Pose true_pose;
 };
 
-Pair simulatedPair(const char* json) {
+// The target from the scene's first scan; the second, down-sampled at `source_voxel` m, the source.
+Pair simulatedPair(const char* json, double source_voxel = 0.1) {
   const mlmap::sim::Scene scene = mlmap::sim::parseScene(json, "scene.json");
   const auto scans = mlmap::sim::simulate(scene);
   Pair pair;
@@ -66,7 +67,7 @@ Pair simulatedPair(const char* json) {
   for (std::size_t i = 0; i < scans[0].scan.size(); ++i) world.push_back(scans[0].scan.worldPoint(i));
   pair.target.addPoints(world);
   pair.target.estimateNormals();
-  pair.source = voxelDownSample(scans[1].scan.points, 0.1);
+  pair.source = voxelDownSample(scans[1].scan.points, source_voxel);
   pair.true_pose = scans[1].true_pose;
   return pair;
 }
@@ -189,9 +190,7 @@ TEST_CASE("ICP: from a far start on a dense source the answer comes from every p
   // 28 deg it ends with the gate at 0.93 m, and the middle stage (every third point) steers
   // until the gate is under 0.2 m. Either way the answer is every point's: a run that stopped
   // on the subset would count at most a third of them as inliers.
-  Pair pair = simulatedPair(kRoomJson);
-  const auto scans = mlmap::sim::simulate(mlmap::sim::parseScene(kRoomJson, "scene.json"));
-  pair.source = voxelDownSample(scans[1].scan.points, 0.05);
+  const Pair pair = simulatedPair(kRoomJson, 0.05);
   REQUIRE(pair.source.size() > 9000);
   for (const double angle_deg : {10.0, 28.0}) {
     CAPTURE(angle_deg);

@@ -105,11 +105,9 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   return m;
 }
 
-long coarseStride(std::size_t points) {
-  return std::max(1L, static_cast<long>(points / kCoarsePoints));
-}
-long middleStride(std::size_t points) {
-  return std::max(1L, static_cast<long>(points / kMiddlePoints));
+// Every how many points a sample of about `sample` points of `points` takes (at least 1).
+long sampleStride(std::size_t points, std::size_t sample) {
+  return std::max(1L, static_cast<long>(points / sample));
 }
 
 // Adds one correspondence's Geman–McClure weighted term to Σ w·JᵀJ and Σ w·Jᵀr, for the
@@ -319,7 +317,9 @@ IcpResult alignPoints(const std::vector<Point>& source, const VoxelHashMap& targ
   LinearSystem system;
   Vector6d previous_step = Vector6d::Zero();  // the coarse stage's last step, rotations in metres
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
-    const long stride = coarse ? coarseStride(source.size()) : dense ? 1 : middleStride(source.size());
+    const long stride = coarse ? sampleStride(source.size(), kCoarsePoints)
+                        : dense ? 1
+                                : sampleStride(source.size(), kMiddlePoints);
     // The kernel scale is a third of the gate: while the pose is still uncertain every
     // correspondence in the gate pulls, even when most residuals are already small. In the
     // coarse stage the gate is wide to reach far partners, and a tighter kernel keeps the
