@@ -8,6 +8,7 @@
 #include <numbers>
 #include <vector>
 
+#include "mlmap/error.hpp"
 #include "mlmap/registration/verified_icp.hpp"
 #include "long_corridor.hpp"
 #include "verified_pairs.hpp"
@@ -108,6 +109,10 @@ TEST_CASE("alignVerified: the source's surfaces given once give the same answer 
     CHECK(given.icp.pose.matrix() == measured.icp.pose.matrix());
     CHECK(given.check.explained_share == measured.check.explained_share);
   }
+  // Another cloud's surfaces are refused, not used.
+  CloudSurfaces other = surfaces;
+  other.normals.pop_back();
+  CHECK_THROWS_AS(alignVerified(pair.source, other, pair.target, pair.true_pose), mlmap::Error);
 }
 
 TEST_CASE("alignVerified: a finely scanned pair with 1 cm noise verifies at the first run") {

@@ -2,6 +2,7 @@
 
 #include "mlmap/registration/slide_profile.hpp"
 #include "turned_rivals.hpp"
+#include "mlmap/error.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <string>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -226,6 +228,11 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
 
 VerifiedIcp alignVerified(const std::vector<Point>& source, const CloudSurfaces& surfaces, const VoxelHashMap& target,
                           const Pose& start, const IcpConfig& icp, const BasinConfig& config) {
+  // Normals of another cloud would leave the slide profile and the rivals without their
+  // surfaces, silently: a caller's error, said as one.
+  if (!source.empty() && !target.empty() && surfaces.normals.size() != source.size())
+    throw Error("alignVerified: " + std::to_string(surfaces.normals.size()) + " source normals given for " +
+                std::to_string(source.size()) + " source points (cloudSurfaces of another cloud?)");
   VerifiedIcp out;
   out.start = out.kept_start = start;
   out.icp.pose = start;

@@ -167,7 +167,8 @@ VerifiedIcp alignVerified(const std::vector<Point>& source, const VoxelHashMap& 
 // The same with the source's normals and noise given: `surfaces` must be
 // cloudSurfaces(source, target.voxelSize()). A source aligned to several targets of one voxel
 // size (a sequence's pairs) measures them once: on the simulated lab's 8 scans `mlmap register`
-// measured them 24 times, 0.85 s of its 2.6 s.
+// measured them 24 times, 0.85 s of its 2.6 s. Throws mlmap::Error when `surfaces` holds
+// another count of normals than `source` has points.
 VerifiedIcp alignVerified(const std::vector<Point>& source, const CloudSurfaces& surfaces, const VoxelHashMap& target,
                           const Pose& start, const IcpConfig& icp = {}, const BasinConfig& config = {});
 
