@@ -114,7 +114,9 @@ std::string_view className(PlaneClass plane_class) {
   return "other";
 }
 
-void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, std::span<const SurfaceSample> surface) {
+void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, std::span<const SurfaceSample> surface,
+                    std::vector<std::uint8_t>* landings) {
+  if (landings != nullptr) landings->assign(planes.size(), 0);
   std::vector<std::size_t> horizontal;
   std::vector<Extent> extents;
   for (std::size_t k = 0; k < planes.size(); ++k) {
@@ -204,7 +206,7 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   auto mayStep = [&](std::size_t k) {
     return (planes[k].label == PlaneClass::Other || !isLevel(planes[k].normal, config)) && belowCeiling(planes[k]);
   };
-  std::vector<std::uint8_t> step(planes.size(), 0);  // 1: a step; 0 and 2: not
+  std::vector<std::uint8_t> step(planes.size(), 0);  // 1: a step; 3: a landing; 0 and 2: not
   // Grows a flight from `members` (marked in `step` already) through riser links to `candidates`.
   auto grow = [&](std::vector<std::size_t>& members, const std::vector<std::size_t>& candidates) {
     for (std::size_t n = 0; n < members.size(); ++n) {
@@ -214,6 +216,21 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
           members.push_back(k);
         }
       }
+    }
+  };
+  // The flight's landings (step 3): level steps far larger than its treads (landing_min_*).
+  auto markLandings = [&](const std::vector<std::size_t>& flight) {
+    std::vector<double> areas;
+    for (const std::size_t k : flight)
+      if (isLevel(planes[k].normal, config)) areas.push_back(planes[k].area);
+    if (areas.size() < 2) return;
+    for (const std::size_t k : flight) {
+      if (!isLevel(planes[k].normal, config) || planes[k].area < config.landing_min_area) continue;
+      std::vector<double> others;
+      for (const std::size_t o : flight)
+        if (o != k && isLevel(planes[o].normal, config)) others.push_back(planes[o].area);
+      std::nth_element(others.begin(), others.begin() + static_cast<std::ptrdiff_t>(others.size() / 2), others.end());
+      if (planes[k].area >= config.landing_min_treads * others[others.size() / 2]) step[k] = 3;
     }
   };
   if (floor != nullptr) {
@@ -229,6 +246,7 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
       }
     }
     grow(flight, steppable);
+    markLandings(flight);
   } else {
     // Without a floor, level patches only: a band between a table and a seat would make
     // three (Bobkov's room 2 at 10 cm cells: its table and sideboard tops became steps).
@@ -247,7 +265,10 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
     Plane& plane = planes[k];
     if (plane.label != PlaneClass::Other) continue;
     const double above_floor = floor != nullptr ? aboveFloor(plane.centroid) : 0.0;
-    if (step[k] == 1) {
+    if (step[k] == 3) {
+      plane.label = PlaneClass::Floor;
+      if (landings != nullptr) (*landings)[k] = 1;
+    } else if (step[k] == 1) {
       plane.label = PlaneClass::Step;
     } else if (floor != nullptr && above_floor >= config.table_min_height && above_floor <= config.table_max_height) {
       plane.label = PlaneClass::Table;
@@ -289,7 +310,7 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
     plane.label = PlaneClass::Other;
     if (height <= config.riser_max + config.level_tolerance) {
       for (const std::size_t other : horizontal) {
-        if (planes[other].label == PlaneClass::Step &&
+        if ((planes[other].label == PlaneClass::Step || step[other] == 3) &&
             std::abs(planes[other].centroid.z() - extents[k].max.z()) < config.level_tolerance + 0.05 &&
             neighbours(extents[k], extents[other], config.neighbour_gap)) {
           plane.label = PlaneClass::Step;

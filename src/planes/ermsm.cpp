@@ -249,8 +249,9 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   }
   // The steps and faces cut above have no outline yet: classification reads their extents.
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));
-  classifyPlanes(patches.planes, {}, bottoms);
-  mergeLevels(grid, patches, radians(config.kappa_deg), sheets ? config.noise : 0.0);
+  std::vector<std::uint8_t> landings;
+  classifyPlanes(patches.planes, {}, bottoms, &landings);
+  mergeLevels(grid, patches, radians(config.kappa_deg), sheets ? config.noise : 0.0, landings);
   labelCeilingPieces(patches.planes);
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));  // the merged levels'
   stats.stages.merges += stage();

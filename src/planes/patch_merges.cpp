@@ -323,14 +323,20 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
   mergeGroups(grid, set, roots, kappa_rad, noise);
 }
 
-void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad, double noise) {
+void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad, double noise,
+                 const std::vector<std::uint8_t>& landings) {
   const std::vector<Plane>& planes = set.planes;
   std::vector<std::size_t> roots(planes.size());
+  // A landing is floor at its own height: it joins no other floor.
+  const auto mergesAsLevel = [&](std::size_t k) {
+    return (planes[k].label == PlaneClass::Floor || planes[k].label == PlaneClass::Ceiling) &&
+           (k >= landings.size() || landings[k] == 0);
+  };
   for (std::size_t k = 0; k < planes.size(); ++k) {
     roots[k] = k;
-    if (planes[k].label != PlaneClass::Floor && planes[k].label != PlaneClass::Ceiling) continue;
+    if (!mergesAsLevel(k)) continue;
     for (std::size_t first = 0; first < k; ++first) {
-      if (planes[first].label == planes[k].label) {
+      if (planes[first].label == planes[k].label && mergesAsLevel(first)) {
         roots[k] = first;
         break;
       }

@@ -2,6 +2,9 @@
 // accepted apart (coplanar pieces, the pieces of a floor or a ceiling).
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "patch_set.hpp"
 
 namespace mlmap {
@@ -18,8 +21,10 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
                    const std::vector<int>& families = {});
 
 // After classification: floor and ceiling patches are one level each, however far
-// apart (a floor seen between furniture, a ceiling either side of a beam). A merged
-// level's outline is left pending.
-void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad, double noise);
+// apart (a floor seen between furniture, a ceiling either side of a beam); a landing
+// (flagged in `landings`, one per plane; classifyPlanes) is floor at its own height and
+// joins none. A merged level's outline is left pending.
+void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad, double noise,
+                 const std::vector<std::uint8_t>& landings = {});
 
 }  // namespace mlmap

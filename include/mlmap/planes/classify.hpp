@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <span>
 #include <vector>
@@ -35,6 +36,13 @@ struct ClassifyConfig {
   // plane_seg's two; 5 and 10 cm cells): at most 0.13 % of the points lie 0.25 m below;
   // under Bobkov's seats 5-36 %.
   double floor_max_share_below = 0.02;
+  // A flight that climbs from the floor ends on a landing or the next storey's floor: a level
+  // step of at least `landing_min_area` and `landing_min_treads` times the median of the
+  // flight's other level steps is floor, not a step (plane_seg's ANYmal stairs: the upper
+  // landing 3.4 m², 4.6-5.7 times its treads' 0.6-0.75 m², at 5 and 10 cm cells). 1 m²:
+  // a landing is at least as deep as the flight is wide, and a flight is a metre wide or more.
+  double landing_min_area = 1.0;   // m²
+  double landing_min_treads = 3.0;
 };
 
 // A piece of the map's surface: a block's bottom, weighted by its points.
@@ -54,9 +62,11 @@ inline bool isPlumb(const Eigen::Vector3d& normal, const ClassifyConfig& config 
 
 // Sets Plane::label for every plane. The floor is the largest horizontal patch near the
 // lowest one, unless the map's `surface` reaches below it; the ceiling the largest horizontal patch a storey above the floor.
+// A landing that a flight from the floor climbs to is floor too, at its own height:
+// `landings` (optional) gets one flag per plane, set for those.
 // Without a floor no patch is floor, ceiling or table.
 void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config = {},
-                    std::span<const SurfaceSample> surface = {});
+                    std::span<const SurfaceSample> surface = {}, std::vector<std::uint8_t>* landings = nullptr);
 
 // After the floor's and the ceiling's pieces are merged (detectPlanes): a level patch a
 // storey above the largest floor and within `riser_max` of the largest ceiling's plane
