@@ -38,9 +38,11 @@ struct ClassifyConfig {
   double floor_max_share_below = 0.02;
   // A flight that climbs from the floor ends on a landing or the next storey's floor: a level
   // step of at least `landing_min_area` and `landing_min_treads` times the median of the
-  // flight's other level steps is floor, not a step (plane_seg's ANYmal stairs: the upper
-  // landing 3.4 m², 4.6-5.7 times its treads' 0.6-0.75 m², at 5 and 10 cm cells). 1 m²:
-  // a landing is at least as deep as the flight is wide, and a flight is a metre wide or more.
+  // flight's other level steps is floor, not a step. From a flight's geometry, not tuned: a
+  // landing is at least as deep as the flight is wide (0.9 m or more), a tread 0.22-0.35 m
+  // deep (kStepGoing's codes), so a landing holds 2.6 times a tread of its width or more, and
+  // 1 m² at least. The one real flight with a landing in ../shared/data, plane_seg's ANYmal
+  // stairs, has 3.4 m² over treads of 0.6-0.75 m² (4.6-5.7 times) at 5 and 10 cm cells.
   double landing_min_area = 1.0;   // m²
   double landing_min_treads = 3.0;
 };
