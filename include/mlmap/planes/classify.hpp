@@ -39,10 +39,11 @@ struct ClassifyConfig {
   // A flight that climbs from the floor ends on a landing or the next storey's floor: a level
   // step of at least `landing_min_area` and `landing_min_treads` times the median of the
   // flight's other level steps is floor, not a step. From a flight's geometry, not tuned: a
-  // landing is at least as deep as the flight is wide (0.9 m or more), a tread 0.22-0.35 m
-  // deep (kStepGoing's codes), so a landing holds 2.6 times a tread of its width or more, and
-  // 1 m² at least. The one real flight with a landing in ../shared/data, plane_seg's ANYmal
-  // stairs, has 3.4 m² over treads of 0.6-0.75 m² (4.6-5.7 times) at 5 and 10 cm cells.
+  // landing is at least as deep as the flight is wide (0.9 m or more), so 1 m² or more, and
+  // over the common 0.28-0.30 m treads (kStepGoing's codes allow 0.22-0.35 m) it holds 3.0-3.2
+  // times a tread at the least depth (a minimal landing over 0.35 m treads, 2.6 times, stays a
+  // step). The one real flight with a landing in ../shared/data, plane_seg's ANYmal stairs,
+  // has 3.4 m² over treads of 0.6-0.75 m² (4.6-5.7 times) at 5 and 10 cm cells.
   double landing_min_area = 1.0;   // m²
   double landing_min_treads = 3.0;
 };
