@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <vector>
 
@@ -190,4 +191,26 @@ TEST_CASE("Classes: a flight from the floor goes on past a tread that came as a 
   furniture[1].offset = -furniture[1].normal.dot(furniture[1].centroid);
   classifyPlanes(furniture);
   CHECK(furniture[1].label == PlaneClass::Other);
+}
+
+TEST_CASE("Classes: a ceiling piece over a floor with a larger landing above it is measured from the floor") {
+  // A landing is floor at its own height (classifyPlanes): here larger than the floor below
+  // it, 0.7 m higher. The ceiling piece 2.3 m over the floor is only 1.6 m over the landing,
+  // under the 1.8 m a storey asks; measured from the landing it stayed 'other'.
+  const Eigen::Vector3d up(0.0, 0.0, 1.0);
+  std::vector<Plane> planes;
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.0}, 0.0, 2.0, 0.0, 2.0));   // 0: floor, 4 m²
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.7}, 3.0, 6.0, 0.0, 3.0));   // 1: landing, 9 m²
+  planes.push_back(levelPatch(up, {0.0, 0.0, 2.45}, 0.0, 6.0, 0.0, 3.0));  // 2: ceiling
+  planes.push_back(levelPatch(up, {0.0, 0.0, 2.3}, 7.0, 9.0, 0.0, 3.0));   // 3: beyond a doorway
+  planes[0].label = PlaneClass::Floor;
+  planes[1].label = PlaneClass::Floor;
+  planes[2].label = PlaneClass::Ceiling;
+  planes[3].label = PlaneClass::Other;
+  std::vector<Plane> unflagged = planes;
+  labelCeilingPieces(unflagged);
+  CHECK(unflagged[3].label == PlaneClass::Other);  // the landing taken for the floor
+  const std::vector<std::uint8_t> landings{0, 1, 0, 0};
+  labelCeilingPieces(planes, {}, landings);
+  CHECK(planes[3].label == PlaneClass::Ceiling);
 }

@@ -324,11 +324,13 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
 // ceiling's centroid, lies 9 cm below the ceiling's plane there (the two planes lean 1.2°
 // apart in a scan that is not quite flat) and was 'other'; room_scan2 at 10 cm: 8.75 m².
 // Labelled so before the level merge, such pieces joined the ceiling and leaned its plane.
-void labelCeilingPieces(std::vector<Plane>& planes, const ClassifyConfig& config) {
+void labelCeilingPieces(std::vector<Plane>& planes, const ClassifyConfig& config, std::span<const std::uint8_t> landings) {
   const Plane* floor = nullptr;
   const Plane* ceiling = nullptr;
-  for (const Plane& plane : planes) {
-    if (plane.label == PlaneClass::Floor && (floor == nullptr || plane.area > floor->area)) floor = &plane;
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    const Plane& plane = planes[k];
+    const bool landing = k < landings.size() && landings[k] != 0;
+    if (plane.label == PlaneClass::Floor && !landing && (floor == nullptr || plane.area > floor->area)) floor = &plane;
     if (plane.label == PlaneClass::Ceiling && (ceiling == nullptr || plane.area > ceiling->area)) ceiling = &plane;
   }
   if (floor == nullptr || ceiling == nullptr) return;

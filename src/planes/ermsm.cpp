@@ -251,8 +251,8 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));
   std::vector<std::uint8_t> landings;
   classifyPlanes(patches.planes, {}, bottoms, &landings);
-  mergeLevels(grid, patches, radians(config.kappa_deg), sheets ? config.noise : 0.0, landings);
-  labelCeilingPieces(patches.planes);
+  mergeLevels(grid, patches, radians(config.kappa_deg), sheets ? config.noise : 0.0, &landings);
+  labelCeilingPieces(patches.planes, {}, landings);
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));  // the merged levels'
   stats.stages.merges += stage();
   detection.planes = std::move(patches.planes);

@@ -324,13 +324,13 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
 }
 
 void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad, double noise,
-                 const std::vector<std::uint8_t>& landings) {
+                 std::vector<std::uint8_t>* landings) {
   const std::vector<Plane>& planes = set.planes;
   std::vector<std::size_t> roots(planes.size());
+  const auto isLanding = [&](std::size_t k) { return landings != nullptr && k < landings->size() && (*landings)[k] != 0; };
   // A landing is floor at its own height: it joins no other floor.
   const auto mergesAsLevel = [&](std::size_t k) {
-    return (planes[k].label == PlaneClass::Floor || planes[k].label == PlaneClass::Ceiling) &&
-           (k >= landings.size() || landings[k] == 0);
+    return (planes[k].label == PlaneClass::Floor || planes[k].label == PlaneClass::Ceiling) && !isLanding(k);
   };
   for (std::size_t k = 0; k < planes.size(); ++k) {
     roots[k] = k;
@@ -342,7 +342,12 @@ void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad, double 
       }
     }
   }
+  // The merged planes are the roots, in order.
+  std::vector<std::uint8_t> merged_landings;
+  for (std::size_t k = 0; k < planes.size(); ++k)
+    if (roots[k] == k) merged_landings.push_back(isLanding(k) ? 1 : 0);
   mergeGroups(grid, set, roots, kappa_rad, noise);
+  if (landings != nullptr) *landings = std::move(merged_landings);
 }
 
 }  // namespace mlmap

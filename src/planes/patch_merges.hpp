@@ -23,8 +23,9 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
 // After classification: floor and ceiling patches are one level each, however far
 // apart (a floor seen between furniture, a ceiling either side of a beam); a landing
 // (flagged in `landings`, one per plane; classifyPlanes) is floor at its own height and
-// joins none. A merged level's outline is left pending.
+// joins none. The flags follow the planes into their merged order. A merged level's
+// outline is left pending.
 void mergeLevels(const BlockGrid& grid, PatchSet& set, double kappa_rad, double noise,
-                 const std::vector<std::uint8_t>& landings = {});
+                 std::vector<std::uint8_t>* landings = nullptr);
 
 }  // namespace mlmap

@@ -76,7 +76,11 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config = {
 // is ceiling too, not 'other' or 'step': a higher section, or the ceiling of the room
 // next door seen through a doorway, whose height the ceiling's plane gives only roughly
 // that far out. Only the label changes (such a piece is no part of the ceiling's plane, so
-// it is not merged into it). Hanging fixtures and ducts lie further below.
-void labelCeilingPieces(std::vector<Plane>& planes, const ClassifyConfig& config = {});
+// it is not merged into it). Hanging fixtures and ducts lie further below. The floor is
+// the largest floor patch that is no landing (`landings`: one flag per plane, as
+// classifyPlanes and mergeLevels leave them; empty: none): a landing may be larger than the
+// floor below it, a storey's part higher.
+void labelCeilingPieces(std::vector<Plane>& planes, const ClassifyConfig& config = {},
+                        std::span<const std::uint8_t> landings = {});
 
 }  // namespace mlmap
