@@ -220,15 +220,15 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   };
   // The flight's landings (step 3): level steps far larger than its treads (landing_min_*).
   auto markLandings = [&](const std::vector<std::size_t>& flight) {
-    std::vector<double> areas;
+    std::vector<std::size_t> level;
     for (const std::size_t k : flight)
-      if (isLevel(planes[k].normal, config)) areas.push_back(planes[k].area);
-    if (areas.size() < 2) return;
-    for (const std::size_t k : flight) {
-      if (!isLevel(planes[k].normal, config) || planes[k].area < config.landing_min_area) continue;
+      if (isLevel(planes[k].normal, config)) level.push_back(k);
+    if (level.size() < 2) return;
+    for (const std::size_t k : level) {
+      if (planes[k].area < config.landing_min_area) continue;
       std::vector<double> others;
-      for (const std::size_t o : flight)
-        if (o != k && isLevel(planes[o].normal, config)) others.push_back(planes[o].area);
+      for (const std::size_t o : level)
+        if (o != k) others.push_back(planes[o].area);
       std::nth_element(others.begin(), others.begin() + static_cast<std::ptrdiff_t>(others.size() / 2), others.end());
       if (planes[k].area >= config.landing_min_treads * others[others.size() / 2]) step[k] = 3;
     }

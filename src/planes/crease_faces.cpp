@@ -293,9 +293,7 @@ class PatchFaces {
         if (faces[f].members == members[f]) continue;
         moved = true;
         faces[f].members = members[f];
-        faces[f].points = PointMoments{};
-        for (const std::size_t m : members[f]) faces[f].points.add(stats_[m], centres_[m]);
-        fitFace(faces[f]);
+        refit(faces[f]);
       }
       if (moved && ++rounds < kAssignRounds) continue;
       const std::vector<int> face_of = faceOfBlocks(members);
@@ -303,11 +301,9 @@ class PatchFaces {
       for (std::size_t a = 0; a < faces.size() && !merged; ++a) {
         for (std::size_t b = a + 1; b < faces.size() && !merged; ++b) {
           if (angleBetween(faces[a].normal, faces[b].normal) > grow_ || !touches(members[a], face_of, b)) continue;
-          faces[a].points = PointMoments{};
-          for (const std::size_t f : {a, b})
-            for (const std::size_t m : members[f]) faces[a].points.add(stats_[m], centres_[m]);
-          fitFace(faces[a]);
+          // Both faces' members are the blocks they took (members) once the rounds end.
           faces[a].members.insert(faces[a].members.end(), faces[b].members.begin(), faces[b].members.end());
+          refit(faces[a]);
           faces.erase(faces.begin() + static_cast<std::ptrdiff_t>(b));
           for (std::size_t k = 0; k < blocks_.size(); ++k) reach[a][k] = reach[a][k] || reach[b][k];
           reach.erase(reach.begin() + static_cast<std::ptrdiff_t>(b));
@@ -316,6 +312,13 @@ class PatchFaces {
       }
       if (!merged) break;
     }
+  }
+
+  // A face's plane refitted to its members' points.
+  void refit(Face& face) const {
+    face.points = PointMoments{};
+    for (const std::size_t m : face.members) face.points.add(stats_[m], centres_[m]);
+    fitFace(face);
   }
 
   // Per face, the blocks within kReachSteps neighbour steps of the blocks it grew from: a

@@ -1,8 +1,8 @@
 #include "mlmap/registration/verified_icp.hpp"
 
+#include "mlmap/error.hpp"
 #include "mlmap/registration/slide_profile.hpp"
 #include "turned_rivals.hpp"
-#include "mlmap/error.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -11,10 +11,10 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <string>
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <string>
 
 namespace mlmap::registration {
 namespace {
