@@ -3,7 +3,7 @@
 
     /usr/bin/python3 bench/real_data.py [--build build] [--data ../shared/data] [--out out/real]
         [--cells 0.05,0.1] [--peers /work/build-peers] [--only NAME,...] [--docs docs]
-        [--turn DEG --shift X,Y]
+        [--turn DEG --shift X,Y] [--keep SHARE [--keep-seed N]]
 
 Every scene of bench/real_clouds.py (3DTK's three scans, OctoMap's scan.dat, Bobkov's room 2,
 PCL's office1 and two room scans, plane_seg's two stair scans) has an annotation file
@@ -36,6 +36,12 @@ each cell size and CGAL.
 --turn and --shift place the scenes on the cell grid otherwise than their authors' frames do
 (turned about the up axis, moved across by a fraction of a cell); bench/real_seeds.py --placements
 runs twelve such placements, since every constant was tried on the authors' frames.
+
+--keep thins every scan to that share of its points, drawn at random (seeded by --keep-seed)
+before mlmap or CGAL sees them: the same surfaces seen with fewer points (a slower or coarser
+scanner; along each scan line, since whole lines are not dropped). The marked surfaces are the
+same; the authors' own labels (Bobkov's room 2) are not scored on a thinned cloud.
+bench/real_seeds.py --densities runs 1, 0.5 and 0.25 over three thinning draws.
 
 y-up scans (office1) are passed with `--up y` when `mlmap build --help` lists it, otherwise as
 z-up scans (the benchmark turns them itself). Scans go to mlmap as .xyz files in their sensor
@@ -159,6 +165,12 @@ def score(labels, owner, points, planes, annotation, classes=None):
              real_annotations.rms_to_plane(points[labels == p], *planes[p]) > 2.0 * flat_rms]
     return rows, dict(on_patch=int(on_patch.sum()), unmarked=int(unmarked.sum()), patches=len(np.unique(labels[on_patch])),
                       stray_patches=len(stray), stray_points=int(np.isin(labels, stray).sum()), rough_strays=len(rough))
+
+
+def thin(scene, keep, seed):
+    """Keeps a share `keep` of each scan's points, drawn at random (the same draw for a seed)."""
+    draw = np.random.default_rng(seed)
+    scene.scans = [(points[draw.random(len(points)) < keep], r, t) for points, r, t in scene.scans]
 
 
 def posed_options(pose_file, features):
@@ -442,6 +454,9 @@ def main():
                     help="turn every scene by this many degrees about its up axis (and --shift it) before mlmap "
                          "sees it: the buildings' walls then lie off the cell grid (CGAL, grid-free, is not rerun)")
     ap.add_argument("--shift", default="0,0", help="m, with --turn: the scene moved across by x,y (default 0,0)")
+    ap.add_argument("--keep", type=float, default=1.0,
+                    help="share of each scan's points kept, drawn at random (default 1: all): the scans thinned")
+    ap.add_argument("--keep-seed", type=int, default=1, help="seed of --keep's draw (default 1)")
     a = ap.parse_args()
     try:
         shift = tuple(float(v) for v in a.shift.split(","))
@@ -449,6 +464,8 @@ def main():
         shift = ()
     if len(shift) != 2:
         raise SystemExit(f"real_data: --shift takes two numbers, x,y (got {a.shift!r})")
+    if not 0.0 < a.keep <= 1.0:
+        raise SystemExit(f"real_data: --keep takes a share in (0, 1] (got {a.keep})")
     if not os.path.isdir(a.data):
         print(f"real_data: skipped, no data directory at {a.data}")
         return
@@ -472,6 +489,8 @@ def main():
         if scene is None:
             print(f"real_data: {name} skipped ({why})")
             continue
+        if a.keep < 1.0:
+            thin(scene, a.keep, a.keep_seed)
         annotation = real_annotations.load(name)
         if annotation is None:
             print(f"real_data: {name} skipped (no bench/annotations/{name}.json)")
@@ -516,7 +535,7 @@ def main():
         scorer = os.path.join(os.path.dirname(a.data), "peers", "score.py")
         if os.path.exists(scorer):
             text += "\n" + marked_scores(name, folder, world, owner, labelled, scorer) + "\n"
-        if name in AUTHORS_LABELS and os.path.exists(scorer):
+        if name in AUTHORS_LABELS and os.path.exists(scorer) and a.keep == 1.0:
             text += "\nScored on the labels the data's authors made (`../shared/peers/score.py`):\n\n"
             text += "\n".join(authors_scores(a.data, name, folder, world, labelled, scorer)) + "\n"
         print(text, flush=True)

@@ -2,7 +2,8 @@
 """The real-scan figures across detection seeds and grid placements: how much of a change is chance.
 
     /usr/bin/python3 bench/real_seeds.py [--build build] [--against OTHER_BUILD] [--seeds 1,2,3]
-        [--turns 0] [--shifts 0,0] [--placements] [--out out/real-seeds] [--only NAME,...]
+        [--turns 0] [--shifts 0,0] [--keeps 1] [--placements | --densities] [--out out/real-seeds]
+        [--only NAME,...]
 
 eRMSM draws its candidates at random (`mlmap planes --seed`, default 1), and which plane is
 accepted first decides what the others can take. On the real scans of ../shared/data that moves
@@ -17,7 +18,10 @@ per seed, turn (deg, about the up axis) and shift (m, "x,y"; --turns and --shift
 ';'-separated for shifts), per build with --against, and this prints, per build and cell size, each
 draw's totals and their sum, and with --against which marked surfaces pass in one build and not in
 the other, draw by draw. --placements is --seeds 1 --turns 0,10,25,40 --shifts "0,0;0.013,0.027;0.05,0.05"
-(twelve placements, the native one among them). Skipped with a message where ../shared/data is absent.
+(twelve placements, the native one among them). --keeps lists shares of each scan's points kept
+(real_data.py --keep, the thinning drawn with the draw's seed); --densities is --seeds 1,2,3
+--keeps 1,0.5,0.25 (scan density, which no constant was tried on either: a seed then draws both
+the detection and the thinning). Skipped with a message where ../shared/data is absent.
 """
 import argparse, collections, json, os, subprocess, sys
 
@@ -30,12 +34,14 @@ TOTALS = (("found", "found", "marked"), ("walls/floor/ceiling", "structural_foun
 CELLS = ("mlmap 0.05", "mlmap 0.1")
 
 
-class Draw(collections.namedtuple("Draw", "seed turn shift")):
-    """One run of real_data.py: a detection seed, a turn (deg) and a shift ("x,y", m) of the scenes."""
+class Draw(collections.namedtuple("Draw", "seed turn shift keep")):
+    """One run of real_data.py: a detection seed, a turn (deg) and a shift ("x,y", m) of the scenes,
+    the share of their points kept."""
 
     def name(self):
         placed = "" if self.turn == 0.0 and self.shift in ("0,0", "0.0,0.0") else f"-turn{self.turn:g}-shift{self.shift}"
-        return f"seed{self.seed}{placed}"
+        thinned = "" if self.keep == 1.0 else f"-keep{self.keep:g}"
+        return f"seed{self.seed}{placed}{thinned}"
 
 
 def passing(result):
@@ -52,6 +58,9 @@ def main():
     ap.add_argument("--shifts", default="0,0", help="m, 'x,y' pairs separated by ';' (real_data.py --shift)")
     ap.add_argument("--placements", action="store_true",
                     help="seed 1 on twelve grid placements: turns 0,10,25,40 by shifts 0,0; 0.013,0.027; 0.05,0.05")
+    ap.add_argument("--keeps", default="1", help="shares of each scan's points kept, comma-separated (real_data.py --keep)")
+    ap.add_argument("--densities", action="store_true",
+                    help="seeds 1,2,3 at each of keeps 1,0.5,0.25 (the scans thinned, the draw seeded by the seed)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "real-seeds"))
     ap.add_argument("--only", help="comma-separated scene names (real_data.py's)")
     ap.add_argument("--data", default=os.path.join(os.path.dirname(ROOT), "shared", "data"))
@@ -60,23 +69,30 @@ def main():
         print(f"real_seeds: skipped, no data directory at {a.data}")
         return
     builds = [("build", a.build)] + ([("against", a.against)] if a.against else [])
+    if a.placements and a.densities:
+        raise SystemExit("real_seeds: --placements and --densities are two benchmarks: give one")
     if a.placements:
         a.seeds, a.turns, a.shifts = "1", "0,10,25,40", "0,0;0.013,0.027;0.05,0.05"
+    if a.densities:
+        a.seeds, a.keeps = "1,2,3", "1,0.5,0.25"
     try:
-        draws = [Draw(int(seed), float(turn), shift.strip()) for seed in a.seeds.split(",")
-                 for turn in a.turns.split(",") for shift in a.shifts.split(";")]
+        draws = [Draw(int(seed), float(turn), shift.strip(), float(keep)) for keep in a.keeps.split(",")
+                 for seed in a.seeds.split(",") for turn in a.turns.split(",") for shift in a.shifts.split(";")]
         for draw in draws:
             if len([float(v) for v in draw.shift.split(",")]) != 2:
                 raise ValueError(draw.shift)
+            if not 0.0 < draw.keep <= 1.0:
+                raise ValueError(f"keep {draw.keep:g} is no share in (0, 1]")
     except ValueError as error:
-        raise SystemExit(f"real_seeds: --seeds, --turns and --shifts take numbers (a shift is 'x,y'): {error}")
+        raise SystemExit(f"real_seeds: --seeds, --turns, --shifts and --keeps take numbers (a shift is 'x,y'): {error}")
     reports = {}
     for tag, build in builds:
         for draw in draws:
             out = os.path.join(a.out, f"{tag}-{draw.name()}")
             cmd = [sys.executable, os.path.join(HERE, "real_data.py"), "--build", build, "--out", out,
                    "--data", a.data, f"--planes-args=--seed {draw.seed}", "--turn", f"{draw.turn:g}",
-                   "--shift", draw.shift] + (["--only", a.only] if a.only else [])
+                   "--shift", draw.shift, "--keep", f"{draw.keep:g}", "--keep-seed", str(draw.seed)] + \
+                (["--only", a.only] if a.only else [])
             stale = os.path.join(out, "real_data.json")
             if os.path.exists(stale):
                 os.remove(stale)  # a result is this run's or none

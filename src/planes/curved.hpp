@@ -20,9 +20,11 @@ namespace mlmap {
 // (2) is significant over its blocks (F >= 10 for the parabola's term); and (3) turns the
 // surface's normal across the patch by more than κ / 3 (what tells two faces of a crease
 // apart, creases.hpp): a wall bowed by a centimetre over metres turns by well under a
-// degree and stays. Its blocks go back to no patch; ids are renumbered in order and the
-// block labels follow. Needs the blocks' point moments (a map without them: nothing
-// dropped). Returns the number dropped.
-std::size_t dropCurved(const BlockGrid& grid, PatchSet& set, double kappa_rad);
+// degree and stays. A patch that bends so is judged again without its blocks whose points
+// lie beyond `band` (m, its ε) from its plane, where those are few (curved.cpp): a few blocks
+// of another face at a flat wall's end bend the parabola too. Its blocks go back to no
+// patch; ids are renumbered in order and the block labels follow. Needs the blocks' point
+// moments (a map without them: nothing dropped). Returns the number dropped.
+std::size_t dropCurved(const BlockGrid& grid, PatchSet& set, double kappa_rad, double band);
 
 }  // namespace mlmap

@@ -224,7 +224,7 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   if (sheets && hasPointStats(map)) {
     // A strip of a pillar or a round wall is no plane (curved.hpp); before the crease
     // split, which would cut it into faces.
-    dropCurved(grid, patches, radians(config.kappa_deg));
+    dropCurved(grid, patches, radians(config.kappa_deg), std::max(config.epsilon, config.max_epsilon));
     std::vector<int> flights;
     splitSteps(grid, patches, {config.noise, config.min_patch_blocks, config.min_patch_area}, &flights);
     const std::vector<int> faces_of = splitCreases(
