@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "crease_faces.hpp"
+#include "step_faces.hpp"
 
 namespace mlmap {
 namespace {
@@ -23,7 +24,8 @@ std::vector<int> splitCreases(const BlockGrid& grid, PatchSet& set, const Crease
     if (!(plane.rms > kRoughSigmas * config.noise) || set.blocks[k].size() < 2 * static_cast<std::size_t>(config.min_blocks))
       continue;
     if (grid.pointsOf(set.blocks[k].front()).empty()) return split;  // a map without point moments
-    const std::vector<std::vector<std::size_t>> faces = creaseFaces(grid, set, k, config);
+    std::vector<std::vector<std::size_t>> faces = creaseFaces(grid, set, k, config);
+    if (faces.empty()) faces = stepFaces(grid, set, k, config);
     if (faces.empty()) continue;
     const std::vector<std::uint32_t> blocks = set.blocks[k];
     const Plane original = set.planes[k];

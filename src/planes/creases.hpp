@@ -33,7 +33,8 @@ struct CreaseConfig {
 // more than κ / 3 (a crease), the faces' squared residuals are at most a quarter of the
 // patch's over the same blocks (their RMS half), and at most 15 % of the patch's points lie
 // on no face. Blocks on no face, and connected pieces of a face too small for half the
-// minimum area, go back to no patch. The first face keeps the
+// minimum area, go back to no patch. A rough wall patch that no crease splits is split
+// where it is two parallel faces a step apart (step_faces.hpp). The first face keeps the
 // patch's id, the others are appended; their outlines are left pending. Returns, per
 // plane, the index of the patch it was split from (-1 for none); empty where none was.
 std::vector<int> splitCreases(const BlockGrid& grid, PatchSet& set, const CreaseConfig& config);
