@@ -22,9 +22,9 @@ namespace mlmap {
 // Patch k's two faces (indices into set.blocks[k]) where it is a plumb patch whose blocks
 // fall into two groups across it, by their points' mean (the cut that leaves the least
 // scatter): the groups' means at least a sheet's step of the noise apart (3 √2 σ, no cell
-// floor) and four times the blocks' scatter about them, each large enough for a face
-// (tooSmallForFace), the smaller one's stretch of the plane at most a fifth shared with the
-// larger's. None otherwise.
+// floor) and four times the blocks' scatter about them, each with a tenth of the patch's
+// points or more and large enough for a face (tooSmallForFace), the smaller one's stretch
+// of the plane at most a fifth shared with the larger's. None otherwise.
 std::vector<std::vector<std::size_t>> stepFaces(const BlockGrid& grid, const PatchSet& set, std::size_t k,
                                                 const CreaseConfig& config);
 
