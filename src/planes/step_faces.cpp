@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <limits>
+#include <numbers>
+#include <vector>
 
 #include "crease_faces.hpp"
 #include "mlmap/planes/classify.hpp"
@@ -35,14 +36,28 @@ double sharedStretch(const BlockGrid& grid, const std::vector<std::uint32_t>& sm
   if (smaller.empty()) return 1.0;
   const double cell = grid.cellSize();
   const auto meanOf = [&](std::uint32_t id) -> Eigen::Vector3d { return grid.pointsFrameOf(id) + grid.pointsOf(id).mean(); };
+  // The larger face's blocks by their place along the wall: (along, bottom, top).
+  struct Span {
+    double along = 0.0;
+    double bottom = 0.0;
+    double top = 0.0;
+  };
+  std::vector<Span> spans;
+  spans.reserve(larger.size());
+  for (const std::uint32_t id : larger) {
+    const PlaneBlock& block = grid.blocks()[id];
+    spans.push_back({along.dot(meanOf(id)), block.vertical ? block.bottom : block.point.z() - 0.5 * cell,
+                     block.vertical ? block.top : block.point.z() + 0.5 * cell});
+  }
+  std::sort(spans.begin(), spans.end(), [](const Span& a, const Span& b) { return a.along < b.along; });
   std::size_t shared = 0;
-  for (const std::uint32_t a : smaller) {
-    const Eigen::Vector3d p = meanOf(a);
-    for (const std::uint32_t b : larger) {
-      const PlaneBlock& block = grid.blocks()[b];
-      const double bottom = block.vertical ? block.bottom : block.point.z() - 0.5 * cell;
-      const double top = block.vertical ? block.top : block.point.z() + 0.5 * cell;
-      if (std::abs(along.dot(meanOf(b) - p)) <= cell && p.z() >= bottom && p.z() <= top) {
+  for (const std::uint32_t id : smaller) {
+    const Eigen::Vector3d p = meanOf(id);
+    const double at = along.dot(p);
+    auto span = std::lower_bound(spans.begin(), spans.end(), at - cell,
+                                 [](const Span& s, double value) { return s.along < value; });
+    for (; span != spans.end() && span->along <= at + cell; ++span) {
+      if (p.z() >= span->bottom && p.z() <= span->top) {
         ++shared;
         break;
       }
