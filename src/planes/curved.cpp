@@ -62,33 +62,41 @@ double withinSum(const std::vector<Sample>& samples, const Eigen::Vector3d& norm
   return within;
 }
 
-// The bend of a patch across its horizontal direction, from the point moments of its blocks
-// within `band` (m) of its plane; left_share 1 where the blocks keep no points or are too few.
-Bend bendOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Plane& plane, double band) {
-  Bend bend;
-  const Eigen::Vector3d normal = plane.normal.normalized();
-  const Eigen::Vector3d across = Eigen::Vector3d(-normal.y(), normal.x(), 0.0).normalized();
-  const Eigen::Vector3d origin = plane.centroid;
+// The patch's blocks as the bend sees them, about its plane; none for a map without point
+// moments.
+std::vector<Sample> samplesOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Plane& plane,
+                              const Eigen::Vector3d& normal, const Eigen::Vector3d& across) {
   std::vector<Sample> samples;
   samples.reserve(blocks.size());
+  for (const std::uint32_t id : blocks) {
+    const PointStats stats = grid.pointsOf(id);
+    if (stats.empty()) return {};
+    const Eigen::Vector3d mean = grid.pointsFrameOf(id) + stats.mean() - plane.centroid;
+    samples.push_back({across.dot(mean), normal.dot(mean), static_cast<double>(stats.count), stats.scatterMatrix()});
+  }
+  return samples;
+}
+
+// The bend of a patch across its horizontal direction, from those of its blocks' samples
+// within `band` (m) of its plane; left_share 1 where they are too few.
+Bend bendOf(const std::vector<Sample>& all, const Eigen::Vector3d& normal, const Eigen::Vector3d& across, double band) {
+  Bend bend;
+  std::vector<Sample> samples;
+  samples.reserve(all.size());
   Eigen::Matrix3d normal_matrix = Eigen::Matrix3d::Zero();  // Σ w [1 u u²]ᵀ[1 u u²]
   Eigen::Vector3d rhs = Eigen::Vector3d::Zero();            // Σ w [1 u u²]ᵀ d
   double sum_dd = 0.0;                                      // Σ w d²
   double low = std::numeric_limits<double>::infinity();
   double high = -low;
-  for (const std::uint32_t id : blocks) {
-    const PointStats stats = grid.pointsOf(id);
-    if (stats.empty()) return bend;  // a map without point moments
-    const Eigen::Vector3d mean = grid.pointsFrameOf(id) + stats.mean() - origin;
-    if (std::abs(normal.dot(mean)) > band) continue;
-    Sample sample{across.dot(mean), normal.dot(mean), static_cast<double>(stats.count), stats.scatterMatrix()};
+  for (const Sample& sample : all) {
+    if (std::abs(sample.d) > band) continue;
     const Eigen::Vector3d terms(1.0, sample.u, sample.u * sample.u);
     normal_matrix += sample.weight * terms * terms.transpose();
     rhs += sample.weight * sample.d * terms;
     sum_dd += sample.weight * sample.d * sample.d;
     low = std::min(low, sample.u);
     high = std::max(high, sample.u);
-    samples.push_back(std::move(sample));
+    samples.push_back(sample);
   }
   if (samples.size() < 6) return bend;
   // Weighted least squares: what each fit leaves of the means is Σ w d² − bᵀ (Σ w t d).
@@ -113,18 +121,6 @@ bool isBent(const Bend& bend, double kappa_rad) {
   return bend.left_share <= kMaxLeftShare && bend.f >= kMinF && bend.turn > kappa_rad / 3.0;
 }
 
-// How many of the blocks' point means lie further than `band` from the plane.
-std::size_t offBand(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks, const Plane& plane, double band) {
-  const Eigen::Vector3d normal = plane.normal.normalized();
-  std::size_t off = 0;
-  for (const std::uint32_t id : blocks) {
-    const PointStats stats = grid.pointsOf(id);
-    if (stats.empty()) continue;
-    off += std::abs(normal.dot(grid.pointsFrameOf(id) + stats.mean() - plane.centroid)) > band ? 1 : 0;
-  }
-  return off;
-}
-
 }  // namespace
 
 std::size_t dropCurved(const BlockGrid& grid, PatchSet& set, double kappa_rad, double band) {
@@ -134,9 +130,16 @@ std::size_t dropCurved(const BlockGrid& grid, PatchSet& set, double kappa_rad, d
   for (std::size_t k = 0; k < count; ++k) {
     const Plane& plane = set.planes[k];
     if (std::abs(plane.normal.normalized().z()) > kMaxLevelCos) continue;
-    Bend bend = bendOf(grid, set.blocks[k], plane, std::numeric_limits<double>::infinity());
-    if (isBent(bend, kappa_rad) && offBand(grid, set.blocks[k], plane, band) <= kMaxOffBandShare * set.blocks[k].size())
-      bend = bendOf(grid, set.blocks[k], plane, band);
+    const Eigen::Vector3d normal = plane.normal.normalized();
+    const Eigen::Vector3d across = Eigen::Vector3d(-normal.y(), normal.x(), 0.0).normalized();
+    const std::vector<Sample> samples = samplesOf(grid, set.blocks[k], plane, normal, across);
+    Bend bend = bendOf(samples, normal, across, std::numeric_limits<double>::infinity());
+    if (isBent(bend, kappa_rad)) {
+      const auto off_band = std::count_if(samples.begin(), samples.end(),
+                                          [&](const Sample& sample) { return std::abs(sample.d) > band; });
+      if (static_cast<double>(off_band) <= kMaxOffBandShare * static_cast<double>(samples.size()))
+        bend = bendOf(samples, normal, across, band);
+    }
     if (isBent(bend, kappa_rad)) {
       drop[k] = true;
       ++dropped;

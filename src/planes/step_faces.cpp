@@ -97,7 +97,8 @@ std::vector<std::vector<std::size_t>> stepFaces(const BlockGrid& grid, const Pat
     total_woo += s.weight * s.offset * s.offset;
   }
   double best_left = std::numeric_limits<double>::infinity();
-  std::size_t best_cut = 0;  // the first group: samples [0, best_cut)
+  std::size_t best_cut = 0;  // the first group: samples [0, best_cut), of weight first_w
+  double first_w = 0.0, first_wo = 0.0;
   double w = 0.0, wo = 0.0, woo = 0.0;
   for (std::size_t cut = 1; cut < samples.size(); ++cut) {
     w += samples[cut - 1].weight;
@@ -109,14 +110,11 @@ std::vector<std::vector<std::size_t>> stepFaces(const BlockGrid& grid, const Pat
     if (left < best_left) {
       best_left = left;
       best_cut = cut;
+      first_w = w;
+      first_wo = wo;
     }
   }
   if (best_cut == 0) return {};
-  double first_w = 0.0, first_wo = 0.0;
-  for (std::size_t s = 0; s < best_cut; ++s) {
-    first_w += samples[s].weight;
-    first_wo += samples[s].weight * samples[s].offset;
-  }
   const double step = 3.0 * std::numbers::sqrt2 * config.noise;
   const double apart = (total_wo - first_wo) / (total_w - first_w) - first_wo / first_w;
   const double scatter = std::sqrt(std::max(0.0, best_left) / total_w);
