@@ -29,6 +29,17 @@ Plane levelPatch(const Eigen::Vector3d& normal, const Eigen::Vector3d& through, 
   return plane;
 }
 
+// A plumb patch facing +x at x, covering y0..y1 × z0..z1.
+Plane plumbPatch(double x, double y0, double y1, double z0, double z1) {
+  Plane plane;
+  plane.normal = Eigen::Vector3d::UnitX();
+  plane.offset = -x;
+  plane.outline = {{x, y0, z0}, {x, y1, z0}, {x, y1, z1}, {x, y0, z1}};
+  plane.centroid = {x, (y0 + y1) / 2.0, (z0 + z1) / 2.0};
+  plane.area = (y1 - y0) * (z1 - z0);
+  return plane;
+}
+
 }  // namespace
 
 TEST_CASE("Classes: a floor 2° off level, seen in two patches apart, is floor in both") {
@@ -213,4 +224,32 @@ TEST_CASE("Classes: a ceiling piece over a floor with a larger landing above it 
   const std::vector<std::uint8_t> landings{0, 1, 0, 0};
   labelCeilingPieces(planes, {}, landings);
   CHECK(planes[3].label == PlaneClass::Ceiling);
+}
+
+TEST_CASE("Classes: a flight seen from below is its bands and its risers, drawer fronts in one plane are none") {
+  // OctoMap's fr079 at 10 cm cells: the lower steps of the staircase seen from below came as
+  // risers 20 cm tall, one patch each, beside the bands (riser and nosing) of the upper ones,
+  // and were 'other'; two bands alone are no flight.
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d band_normal = Eigen::Vector3d(-0.6, 0.0, 0.8).normalized();
+  std::vector<Plane> planes;
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.0}, 0.0, 5.9, 0.0, 3.0));            // 0: floor
+  planes.push_back(plumbPatch(6.1, 0.0, 3.0, 0.27, 0.47));                          // 1: riser
+  planes.push_back(plumbPatch(6.43, 0.0, 3.0, 0.38, 0.58));                         // 2: riser
+  planes.push_back(levelPatch(band_normal, {6.715, 1.5, 0.61}, 6.53, 6.9, 0.0, 3.0));  // 3: band
+  planes.push_back(levelPatch(band_normal, {7.125, 1.5, 0.78}, 6.95, 7.3, 0.0, 3.0));  // 4: band
+  classifyPlanes(planes);
+  CHECK(planes[0].label == PlaneClass::Floor);
+  for (std::size_t k = 1; k < planes.size(); ++k) {
+    CAPTURE(k);
+    CHECK(planes[k].label == PlaneClass::Step);  // 'other' before
+  }
+  // Three drawer fronts stacked in one plane, each a riser above the next: no flight.
+  std::vector<Plane> drawers{planes[0], plumbPatch(2.0, 1.0, 1.5, 0.1, 0.28), plumbPatch(2.0, 1.0, 1.5, 0.3, 0.48),
+                             plumbPatch(2.0, 1.0, 1.5, 0.5, 0.68)};
+  classifyPlanes(drawers);
+  for (std::size_t k = 1; k < drawers.size(); ++k) {
+    CAPTURE(k);
+    CHECK(drawers[k].label == PlaneClass::Other);
+  }
 }

@@ -275,17 +275,32 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
     }
   }
   // Bands a riser apart and side by side, three or more, are a flight too: one seen from
-  // below, each step its riser and nosing.
+  // below, each step its riser and nosing. Its risers, where a patch holds one alone (a
+  // plumb patch no taller than a band), are steps of it too: OctoMap's fr079 at 10 cm
+  // cells, whose lower steps seen from below came as risers 20 cm tall beside the bands
+  // of the upper ones, and were 'other'. A riser is a going from the next step, not over
+  // it: drawer fronts stacked in one plane are no flight.
+  const auto riser = [&](std::size_t k) {
+    return isPlumb(planes[k].normal, config) &&
+           extents[k].max.z() - extents[k].min.z() <= config.riser_max + config.level_tolerance;
+  };
+  std::vector<std::size_t> below = bands;
+  for (std::size_t k = 0; k < planes.size(); ++k)
+    if (riser(k)) below.push_back(k);
+  const auto goingApart = [&](std::size_t a, std::size_t b) {
+    return !(riser(a) || riser(b)) ||
+           (planes[a].centroid - planes[b].centroid).head<2>().norm() >= config.min_going;
+  };
   std::vector<std::uint8_t> in_flight(planes.size(), 0);
-  for (const std::size_t start : bands) {
+  for (const std::size_t start : below) {
     if (in_flight[start] != 0) continue;
     std::vector<std::size_t> flight{start};
     in_flight[start] = 2;
     for (std::size_t n = 0; n < flight.size(); ++n) {
-      for (const std::size_t k : bands) {
+      for (const std::size_t k : below) {
         const double rise = std::abs(planes[k].centroid.z() - planes[flight[n]].centroid.z());
         if (in_flight[k] == 0 && rise >= config.riser_min && rise <= config.riser_max &&
-            neighbours(extents[k], extents[flight[n]], config.neighbour_gap)) {
+            neighbours(extents[k], extents[flight[n]], config.neighbour_gap) && goingApart(k, flight[n])) {
           in_flight[k] = 2;
           flight.push_back(k);
         }
@@ -306,8 +321,8 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
       plane.label = PlaneClass::Wall;
       continue;
     }
-    // A riser: low, between a step and the floor or another step.
-    plane.label = PlaneClass::Other;
+    // A riser: low, between a step and the floor or another step, or of a flight seen from below.
+    plane.label = in_flight[k] == 1 ? PlaneClass::Step : PlaneClass::Other;
     if (height <= config.riser_max + config.level_tolerance) {
       for (const std::size_t other : horizontal) {
         if ((planes[other].label == PlaneClass::Step || step[other] == 3) &&

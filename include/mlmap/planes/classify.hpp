@@ -26,6 +26,10 @@ struct ClassifyConfig {
   // each, 0.1 m); a seat under a table lies well inside it.
   double step_overlap_depth = 0.1;  // m
   double max_step_overlap = 0.1;
+  // m: consecutive risers of a flight lie a going apart (building codes: 0.22-0.35 m; fr079's
+  // 0.30-0.35 m), drawer fronts stacked in one plane none: a riser joins a flight seen from
+  // below only where the step next to it lies at least this far away across.
+  double min_going = 0.1;
   double wall_min_height = 1.0;     // m, vertical extent of a wall
   double floor_search = 0.5;        // m: the floor is the largest patch this close to the lowest
   double ceiling_min_height = 1.8;  // m above the floor
