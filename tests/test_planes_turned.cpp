@@ -108,24 +108,31 @@ TEST_CASE("Planes turned: a box room turned 7 or 10 deg gives each wall one patc
 // from it (1.3-1.7 cm RMS against the wall's 2.2 cm: more than half of it, so no noise tail
 // by the spread test): two beside the east wall and two beside the north wall. A patch
 // parallel to a wall within 3.5 times the wall's RMS now joins it where their joint fit says
-// they are one surface.
+// they are one surface. That passed with the search's seed 1 only: seeds 4, 5 and 7 left
+// tails 7-10 cm off (4.9 of the wall's RMS, whose patch ends at ε); a piece that far with under
+// a quarter of the points per unit of surface of the wall beside it is now a tail candidate too.
 TEST_CASE("Planes turned: the lab with 3 cm of range noise, turned 10 deg, has no plane beside a wall") {
   sim::Scene scene = sim::loadScene(std::string(MLMAP_SOURCE_DIR) + "/maps/lab.json");
   scene.pattern.range_sigma = 0.03;
   sim::transformScene(scene, sim::Placement{0.0, 0.0, 10.0});
   MLMap map = test::simulatedMap(scene, 0.05);
-  const PlaneDetection detection = detectPlanes(map);
-  int beside = 0;
-  for (const sim::GroundTruthPlane& truth : scene.ground_truth) {
-    if (truth.surface_class != sim::SurfaceClass::Wall) continue;
-    for (const Plane& patch : detection.planes) {
-      if (std::abs(patch.normal.dot(truth.normal)) < std::cos(12.0 * std::numbers::pi / 180.0)) continue;
-      const double apart = std::abs(truth.normal.dot(patch.centroid) + truth.d);
-      if (apart > 0.04 && apart < 0.1 && patch.block_count >= 20) {
-        ++beside;
-        MESSAGE("a patch " << apart << " m from a wall, " << patch.block_count << " blocks, RMS " << patch.rms);
+  for (const int seed : {1, 4, 5, 7}) {
+    CAPTURE(seed);
+    ErmsmConfig config;
+    config.seed = seed;
+    const PlaneDetection detection = detectPlanes(map, config);
+    int beside = 0;
+    for (const sim::GroundTruthPlane& truth : scene.ground_truth) {
+      if (truth.surface_class != sim::SurfaceClass::Wall) continue;
+      for (const Plane& patch : detection.planes) {
+        if (std::abs(patch.normal.dot(truth.normal)) < std::cos(12.0 * std::numbers::pi / 180.0)) continue;
+        const double apart = std::abs(truth.normal.dot(patch.centroid) + truth.d);
+        if (apart > 0.04 && apart < 0.1 && patch.block_count >= 20) {
+          ++beside;
+          MESSAGE("a patch " << apart << " m from a wall, " << patch.block_count << " blocks, RMS " << patch.rms);
+        }
       }
     }
+    CHECK(beside == 0);
   }
-  CHECK(beside == 0);
 }
