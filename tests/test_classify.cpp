@@ -57,6 +57,37 @@ TEST_CASE("Classes: a floor 2° off level, seen in two patches apart, is floor i
   CHECK(planes[3].label == PlaneClass::Table);
 }
 
+// 3DTK's corridor at 0.2 m cells, in a frame 2.9° off level: the floor's 20 m² patch near the
+// start, a rough 2 m² piece 6 m further on whose centroid lies 0.55 m lower in z but only 0.3 m
+// below the floor's plane. "The lowest patches" were taken in z, so the floor's own patch lay
+// beyond the search and the rough piece's neighbour was the floor.
+TEST_CASE("Classes: the floor of a long corridor 3° off level is the largest patch, not the lowest in z") {
+  const double tilt = 3.0 * std::numbers::pi / 180.0;
+  const Eigen::Vector3d up(-std::sin(tilt), 0.0, std::cos(tilt));
+  std::vector<Plane> planes;
+  planes.push_back(levelPatch(up, {0.0, 0.0, 0.0}, 0.0, 8.0, 0.0, 2.5));             // the floor, centroid z 0.21
+  planes.push_back(levelPatch(up, {0.0, 0.0, -0.08}, 9.0, 11.0, 0.0, 1.0));          // a far piece, z 0.44
+  planes.push_back(levelPatch(up, {0.0, 0.0, -0.33}, 11.0, 12.0, 0.0, 1.0));         // rough, z 0.27
+  planes.push_back(levelPatch(up, {0.0, 0.0, 2.6}, 0.0, 12.0, 0.0, 2.5));            // the ceiling
+  // In z the rough piece lies 0.06 m above the floor's centroid; the lowest in z is the
+  // floor's near end. Turned the other way the far end is lowest:
+  for (const double sign : {1.0, -1.0}) {
+    CAPTURE(sign);
+    std::vector<Plane> seen = planes;
+    if (sign < 0.0) {
+      const Eigen::Vector3d down_x(std::sin(tilt), 0.0, std::cos(tilt));
+      seen[0] = levelPatch(down_x, {0.0, 0.0, 0.0}, 0.0, 8.0, 0.0, 2.5);             // centroid z -0.21
+      seen[1] = levelPatch(down_x, {0.0, 0.0, -0.08}, 9.0, 11.0, 0.0, 1.0);          // z -0.60
+      seen[2] = levelPatch(down_x, {0.0, 0.0, -0.33}, 11.0, 12.0, 0.0, 1.0);         // z -0.93: lowest by 0.72 m
+      seen[3] = levelPatch(down_x, {0.0, 0.0, 2.6}, 0.0, 12.0, 0.0, 2.5);
+    }
+    classifyPlanes(seen);
+    CHECK(seen[0].label == PlaneClass::Floor);
+    CHECK(seen[3].label == PlaneClass::Ceiling);
+    CHECK(seen[2].label != PlaneClass::Floor);  // 0.33 m below the floor's plane
+  }
+}
+
 TEST_CASE("Classes: a level patch with the map's surface under it is no floor (a cloud cut above its floor)") {
   // Bobkov's room 2 is cut at z 1.5, above its floor: the lowest level patches are chair
   // seats 0.4 m higher, with their legs and the walls' feet below them.

@@ -128,14 +128,20 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   // real scans are seldom level (3DTK's floor 4° off in its registered frame, PCL's
   // room_scan2 2°), and across a room of 5 m two patches of one such floor differ by
   // 8-35 cm in z at their centroids.
+  // "The lowest" is measured from each candidate's own plane too: in a frame turned a few
+  // degrees off level, z at the centroids of one floor's patches differs by more than the
+  // search reaches (3DTK's corridor at 0.2 m cells, 2.9° off: a rough 2 m² patch at its far
+  // end lay 0.55 m lower in z than the floor's 20 m² patch, 0.33 m below the floor's plane,
+  // and the floor came out 'other').
   const Plane* floor = nullptr;
   const Plane* ceiling = nullptr;
-  double lowest = std::numeric_limits<double>::infinity();
-  for (const std::size_t k : horizontal) lowest = std::min(lowest, planes[k].centroid.z());
+  const auto amongLowest = [&](const Plane& candidate) {
+    return std::all_of(horizontal.begin(), horizontal.end(), [&](std::size_t other) {
+      return candidate.normal.dot(planes[other].centroid) + candidate.offset >= -config.floor_search;
+    });
+  };
   for (const std::size_t k : horizontal) {
-    if (planes[k].centroid.z() <= lowest + config.floor_search && (floor == nullptr || planes[k].area > floor->area)) {
-      floor = &planes[k];
-    }
+    if ((floor == nullptr || planes[k].area > floor->area) && amongLowest(planes[k])) floor = &planes[k];
   }
   if (floor != nullptr && !surface.empty()) {
     double below = 0.0, total = 0.0;
