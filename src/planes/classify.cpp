@@ -143,6 +143,17 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   for (const std::size_t k : horizontal) {
     if ((floor == nullptr || planes[k].area > floor->area) && amongLowest(planes[k])) floor = &planes[k];
   }
+  // Where every candidate's plane (up to 15° off level) puts another patch far below it, the
+  // lowest in z, as before.
+  if (floor == nullptr) {
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const std::size_t k : horizontal) lowest = std::min(lowest, planes[k].centroid.z());
+    for (const std::size_t k : horizontal) {
+      if (planes[k].centroid.z() <= lowest + config.floor_search && (floor == nullptr || planes[k].area > floor->area)) {
+        floor = &planes[k];
+      }
+    }
+  }
   if (floor != nullptr && !surface.empty()) {
     double below = 0.0, total = 0.0;
     for (const SurfaceSample& sample : surface) {
