@@ -23,6 +23,7 @@ struct ScanOptions {
   io::IsolationFilter isolated;  // set by the commands that offer it (build)
   std::string mount;  // from `mlmap calibrate`
   std::string up;     // x y z -x -y -z auto; empty: z, with a warning when the data disagree
+  bool level = false; // turn the level surfaces exactly to +z (after --up's turn)
 };
 
 struct ScanOptionSet {
@@ -34,9 +35,9 @@ struct ScanOptionSet {
 void addScanOptions(CLI::App* command, ScanOptions& options, const ScanOptionSet& set);
 
 // The scans as the options say, with the mount correction applied and the world turned
-// z-up as --up asks. The constructor checks the files, the pose file and the mount, and
-// resolves --up (reading the first file for auto or to warn), printing on stderr
-// what it decided.
+// z-up as --up asks (and levelled as --level asks). The constructor checks the files, the
+// pose file and the mount, and resolves --up and --level (reading the first file for auto,
+// --level or to warn), printing on stderr what it decided.
 class ScanReading {
  public:
   ScanReading(const ScanOptions& options, const char* command, bool quiet);
@@ -50,7 +51,12 @@ class ScanReading {
   ScanReading withPoses(std::vector<io::StampedPose> poses) const;
 
  private:
-  void resolveUp(const std::string& up);
+  void resolveUp(const std::string& up, bool level);
+  // The first file's scans, in the world frame as turned so far.
+  std::vector<Scan> firstScans() const;
+  // Turns the world so that the first file's level surfaces face +z exactly (--level), or
+  // warns where they lean over kWarnTiltDeg and no --level was given.
+  void levelSurfaces(const std::vector<Scan>& first, bool level);
   io::ScanInputCounts read(const io::ScanSequence::Visit& visit, const std::function<void(std::size_t file)>& file_done,
                            std::size_t max_files) const;
 

@@ -25,6 +25,9 @@ order; the points' coordinates play no part in it). Conditions:
     lines2   every other scan line (twice the tilt step)  sparse  tilt 2 deg, 0.5 deg per beam
     yup      turned so that +y is up (z -> y), built with --up y when `mlmap build --help`
              lists it, else skipped with a message
+    tilt3    the whole scene pitched 3 deg and rolled 1 deg, as from a scanner standing off
+             level (not in the default run; add it with --conditions); tilt3level the same,
+             built and labelled with --level
     rings16  a 16-line scanner's pattern: 360 deg, lines at -15..15 deg every 2 deg, 0.2 deg
              per beam (not in the default run)
     odom     the drifting odometry poses corrected by `mlmap register` instead of the true
@@ -78,6 +81,8 @@ CONDITIONS = {
     "rings16": {"field_of_view_deg": 360, "tilt_start_deg": -15.0, "tilt_end_deg": 15.0, "tilt_step_deg": 2.0,
                 "angular_step_deg": 0.2},
     "yup": {},
+    "tilt3": {},
+    "tilt3level": {},
     "odom": {},
     "cloud": {},
 }
@@ -136,10 +141,30 @@ def matrix_to_quat(m):
     return list(q) if q[3] >= 0 else [-c for c in q]
 
 
-def rigid(angle, shift_m, up_y):
+def rot_x(deg):
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]
+
+
+def rot_y(deg):
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]
+
+
+# The tilt3 variants: the world pitched and rolled as a scan whose scanner stood a few
+# degrees off level (3DTK's three scans: 4.3 deg of pitch and 1 deg of roll, as `mlmap
+# calibrate` finds them).
+TILT_PITCH_DEG, TILT_ROLL_DEG = 3.0, 1.0
+
+
+def rigid(angle, shift_m, up_y, tilted=False):
     """The variant's world motion (R, t): turn about z by angle, shift by (dx, dy), then,
-    for a y-up variant, turn the whole world so that z becomes y."""
+    for a y-up variant, turn the whole world so that z becomes y; for a tilted one, pitch
+    and roll it off level."""
     r, t = rot_z(angle), [shift_m[0], shift_m[1], 0.0]
+    if tilted:
+        tilt = matmul(rot_y(TILT_PITCH_DEG), rot_x(TILT_ROLL_DEG))
+        r, t = matmul(tilt, r), apply(tilt, t)
     if up_y:
         r, t = matmul(Z_TO_Y, r), apply(Z_TO_Y, t)
     return r, t
@@ -322,13 +347,13 @@ def main():
     for scene, cell, cond, angle, seed in variants:
         if (scene, cell, cond, float(angle), seed) in done:
             continue
-        sim_cond = "base" if cond in ("yup", "odom", "cloud") else cond
+        sim_cond = "base" if cond in ("yup", "tilt3", "tilt3level", "odom", "cloud") else cond
         for c in dict.fromkeys(["base", sim_cond]):  # base first: the cut scales by its points
             if (scene, c) not in sims:
                 sims[(scene, c)] = simulate(mlmap, scene, c, os.path.join(a.out, "sim"), a.resimulate)
         sim, sigma, g = sims[(scene, sim_cond)]
         shift = shift_cells(seed)
-        r, t = rigid(angle, (shift[0] * cell, shift[1] * cell), cond == "yup")
+        r, t = rigid(angle, (shift[0] * cell, shift[1] * cell), cond == "yup", cond in ("tilt3", "tilt3level"))
         tag = f"{scene}-{cell:g}-{cond}-{angle:g}deg-s{seed}"
         vdir = os.path.join(a.out, "run")
         os.makedirs(vdir, exist_ok=True)
@@ -340,7 +365,7 @@ def main():
             write_moved_poses(os.path.join(sim, "poses_odom.txt"), poses + ".odom", r, t)
             pb.run([mlmap, "-q", "register", "--poses", poses + ".odom", "-o", poses] + scans)
         files = [os.path.join(vdir, tag + ext) for ext in (".mlmap", ".labelled.mlmap", ".planes.json", ".labels.xyz")]
-        up = ["--up", "y"] if cond == "yup" else []
+        up = ["--up", "y"] if cond == "yup" else ["--level"] if cond == "tilt3level" else []
         if cond == "cloud":  # one registered cloud, as labelled rooms come: no poses, no beams
             scans, poses = [write_moved_cloud(os.path.join(sim, "all_world.xyz"), os.path.join(vdir, tag + ".xyz"),
                                               r, t)], None

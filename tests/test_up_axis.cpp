@@ -3,8 +3,10 @@
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "box_room_rays.hpp"
 #include "mlmap/registration/up_axis.hpp"
@@ -158,4 +160,39 @@ TEST_CASE("Up axis: planes that face no coordinate axis give no line (a tilted c
   CHECK(tilted.planar_share == 0.0);
   CHECK(tilted.faces_no_axis);
   CHECK_FALSE(estimateUpAxis({turned(roomScan(), Eigen::Matrix3d::Identity())}).faces_no_axis);
+}
+
+// A scanner standing off level (3DTK's three scans: 4.3 deg of pitch and 1 deg of roll by
+// `mlmap calibrate`): the room's floor and ceiling lean off z, and its walls across the map's
+// cell rows (build --level turns them back).
+TEST_CASE("Up axis: the level surfaces of a room pitched 3 deg and rolled 1 deg are measured to 0.2 deg and levelled") {
+  const std::vector<Point> room = roomScan();
+  const auto level = registration::levelNormal({turned(room, Eigen::Matrix3d::Identity())}, Eigen::Vector3d::UnitZ());
+  REQUIRE(level);
+  CHECK(std::acos(level->z()) * 180.0 / std::numbers::pi < 0.2);
+  const Eigen::Matrix3d tilt = about(Eigen::Vector3d::UnitY(), 3.0) * about(Eigen::Vector3d::UnitX(), 1.0);
+  const Scan tilted_room = turned(room, tilt);
+  // z-up still, by its planes; about -z the same normal, on -z's side.
+  CHECK(estimateUpAxis({tilted_room}).up.isApprox(Eigen::Vector3d::UnitZ()));
+  const auto tilted = registration::levelNormal({tilted_room}, Eigen::Vector3d::UnitZ());
+  const auto below = registration::levelNormal({tilted_room}, -Eigen::Vector3d::UnitZ());
+  REQUIRE(tilted);
+  REQUIRE(below);
+  const Eigen::Vector3d truth = tilt * Eigen::Vector3d::UnitZ();
+  CHECK(std::acos(std::min(1.0, tilted->dot(truth))) * 180.0 / std::numbers::pi < 0.2);
+  CHECK(below->isApprox(-*tilted, 1e-12));
+  // Levelled, the floor (1 m below the sensor before the tilt) is level again: 6 m of it
+  // within 0.2 deg.
+  const Scan back = turned(tilted_room.points, registration::rotationToLevel(*tilted));
+  std::vector<double> floor;
+  for (std::size_t k = 0; k < room.size(); ++k)
+    if (std::abs(room[k].z() + 1.0) < 1e-9) floor.push_back(back.points[k].z());
+  REQUIRE(floor.size() > 1000);
+  const auto [low, high] = std::minmax_element(floor.begin(), floor.end());
+  CHECK(*high - *low < 6.0 * std::tan(0.2 * std::numbers::pi / 180.0));
+  // A wall alone faces no z: nothing to level by.
+  std::vector<Point> wall;
+  for (const Point& point : room)
+    if (std::abs(point.x() - 4.0) < 1e-9) wall.push_back(point);
+  CHECK_FALSE(registration::levelNormal({turned(wall, Eigen::Matrix3d::Identity())}, Eigen::Vector3d::UnitZ()));
 }

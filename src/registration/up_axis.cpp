@@ -7,6 +7,9 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <optional>
+#include <utility>
+#include <vector>
 #include <unordered_map>
 
 namespace mlmap::registration {
@@ -85,10 +88,36 @@ int movedPlaneAxis(const std::vector<Pose>& poses) {
   return snappedAxis(solver.eigenvectors().col(0));
 }
 
-}  // namespace
+// The mean of the facing cells' normals weighted by their points, twice again without
+// those more than kLevelSpreadDeg from it (a ramp, a chair's tilted seat, a cell holding a
+// step's edge); none where fewer than kMinPlanarCells remain.
+constexpr double kLevelSpreadDeg = 3.0;
 
-UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig& config,
-                              const std::vector<Pose>& sequence_poses) {
+std::optional<Eigen::Vector3d> meanDirection(const std::vector<std::pair<Eigen::Vector3d, double>>& normals) {
+  if (normals.size() < kMinPlanarCells) return std::nullopt;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& [normal, weight] : normals) mean += weight * normal;
+  const double keep = std::cos(kLevelSpreadDeg * std::numbers::pi / 180.0);
+  for (int round = 0; round < 2; ++round) {
+    const Eigen::Vector3d centre = mean.normalized();
+    Eigen::Vector3d next = Eigen::Vector3d::Zero();
+    std::size_t kept = 0;
+    for (const auto& [normal, weight] : normals) {
+      if (normal.dot(centre) < keep) continue;
+      next += weight * normal;
+      ++kept;
+    }
+    if (kept < kMinPlanarCells) return std::nullopt;
+    mean = next;
+  }
+  return mean.normalized();
+}
+
+// Each planar cell of the scans' points (thinned evenly to config.max_points) with its
+// normal: cells of config.cell_size holding kMinCellPoints or more whose smallest spread is
+// under kFlatness of the middle one.
+template <typename Visit>
+void forEachPlanarCell(const std::vector<Scan>& scans, const UpAxisConfig& config, Visit&& visit) {
   std::size_t total = 0;
   for (const Scan& scan : scans) total += scan.size();
   const std::size_t stride = config.max_points == 0 ? 1 : std::max<std::size_t>(1, total / config.max_points + 1);
@@ -106,10 +135,6 @@ UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig
       for (int axis = 0; axis < 3; ++axis) cell.below[axis] += point[axis] < origin[axis] ? 1 : 0;
     }
   }
-
-  // Planar cells by the axis they face (-1: none), with their points.
-  std::array<std::size_t, 3> facing{}, below{}, on_family{};
-  UpAxisEstimate estimate;
   for (const auto& [key, cell] : cells) {
     if (cell.count < kMinCellPoints) continue;
     const double n = static_cast<double>(cell.count);
@@ -118,14 +143,26 @@ UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
     const Eigen::Vector3d values = solver.eigenvalues();  // ascending
     if (!(values(0) < kFlatness * values(1))) continue;
-    ++estimate.planar_cells;
-    const Eigen::Vector3d normal = solver.eigenvectors().col(0);
-    Eigen::Index axis = 0;
-    if (normal.cwiseAbs().maxCoeff(&axis) < kFacingCos) continue;
-    ++facing[static_cast<std::size_t>(axis)];
-    on_family[static_cast<std::size_t>(axis)] += cell.count;
-    below[static_cast<std::size_t>(axis)] += cell.below[static_cast<std::size_t>(axis)];
+    visit(Eigen::Vector3d(solver.eigenvectors().col(0)), cell);
   }
+}
+
+}  // namespace
+
+UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig& config,
+                              const std::vector<Pose>& sequence_poses) {
+  // Planar cells by the axis they face (-1: none), with their points.
+  std::array<std::size_t, 3> facing{}, below{}, on_family{};
+  UpAxisEstimate estimate;
+  forEachPlanarCell(scans, config, [&](const Eigen::Vector3d& normal, const CellSums& cell) {
+    ++estimate.planar_cells;
+    Eigen::Index axis = 0;
+    if (normal.cwiseAbs().maxCoeff(&axis) < kFacingCos) return;
+    const auto a = static_cast<std::size_t>(axis);
+    ++facing[a];
+    on_family[a] += cell.count;
+    below[a] += cell.below[a];
+  });
 
   std::vector<Pose> poses = sequence_poses;
   if (poses.empty()) {
@@ -155,6 +192,22 @@ UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig
   // A tie keeps the positive axis: no evidence against the data's own convention.
   estimate.up[line] = estimate.below_share >= 0.5 ? 1.0 : -1.0;
   return estimate;
+}
+
+Eigen::Matrix3d rotationToLevel(const Eigen::Vector3d& normal) {
+  return Eigen::Quaterniond::FromTwoVectors(normal.normalized(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
+std::optional<Eigen::Vector3d> levelNormal(const std::vector<Scan>& scans, const Eigen::Vector3d& up,
+                                           const UpAxisConfig& config) {
+  const Eigen::Vector3d axis = up.normalized();
+  std::vector<std::pair<Eigen::Vector3d, double>> normals;
+  forEachPlanarCell(scans, config, [&](const Eigen::Vector3d& normal, const CellSums& cell) {
+    const double along = normal.dot(axis);
+    if (std::abs(along) >= kFacingCos)
+      normals.emplace_back(along < 0.0 ? Eigen::Vector3d(-normal) : normal, static_cast<double>(cell.count));
+  });
+  return meanDirection(normals);
 }
 
 Eigen::Matrix3d rotationToZUp(const Eigen::Vector3d& up) {

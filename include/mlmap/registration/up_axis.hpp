@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "mlmap/scan.hpp"
@@ -48,6 +49,16 @@ UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig
 // The rotation turning `up` (a signed coordinate axis) into +z: identity, a quarter
 // turn about x or y, or a half turn about x.
 Eigen::Matrix3d rotationToZUp(const Eigen::Vector3d& up);
+
+// The normal of the level surfaces about the signed axis `up`: the planar cells facing it
+// within 15 deg, their normals' mean without those more than 3 deg from it, on `up`'s side;
+// none where fewer than 20 such cells remain. A scanner standing a few degrees off level
+// tilts it off the axis, and the walls then lean across the map's cell rows.
+std::optional<Eigen::Vector3d> levelNormal(const std::vector<Scan>& scans, const Eigen::Vector3d& up,
+                                           const UpAxisConfig& config = {});
+
+// The shortest rotation turning `normal` into +z (no turn about it).
+Eigen::Matrix3d rotationToLevel(const Eigen::Vector3d& normal);
 
 // "+z", "-y", ...: the axis as the CLI's --up names it.
 const char* axisName(const Eigen::Vector3d& up);
