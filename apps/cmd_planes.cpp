@@ -104,7 +104,10 @@ void addPlanesCommand(CLI::App& app, Context& context) {
   command->add_option("-o,--output", arguments->output, "Write the map with its blocks labelled");
   command->add_option("--seed", config.seed, "Random seed (same seed, same planes)")->capture_default_str();
   addNumber(command, "--threads", config.threads, "Threads (default: all cores)", 0, Bound::Closed);
-  addNumber(command, "--radius", config.radius, "r: neighbourhood radius, cells", 1, Bound::Closed, 50)
+  addNumber(command, "--radius", config.radius,
+            "r: neighbourhood radius, cells (default 0: 2, and 1 where a cell is wider than 0.1 m: the window "
+            "reaches at most 0.2 m out)",
+            0, Bound::Closed, 50)
       ->capture_default_str();
   addNumber(command, "--epsilon", config.epsilon,
             "ε: max block-plane distance, m (default: max(3 σ, min(cell size, 0.05)); maps without point moments: max(cell size, min(3 σ, 0.05)))", 0.0, Bound::Closed, 10.0);

@@ -13,7 +13,9 @@
 namespace mlmap {
 
 struct ErmsmConfig {
-  int radius = 2;                 // cells, Chebyshev radius r (direction vectors, candidate seeds)
+  // cells, Chebyshev radius r (direction vectors, candidate seeds); 0 = 2, and 1 where a cell is
+  // wider than 0.1 m (defaultRadius: a window at most 0.2 m out)
+  int radius = 0;
   // cells: a level block's direction window widens up to this where r cells leave its
   // normal uncertain (standard error over θ / 3.5: noisy or sparse surfaces); 0 = 2 r
   int max_radius = 0;
