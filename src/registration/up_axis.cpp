@@ -90,7 +90,7 @@ int movedPlaneAxis(const std::vector<Pose>& poses) {
 
 // A level cell's normal lies this far from the level surfaces' at most: more is a ramp, a
 // chair's tilted seat or a cell holding a step's edge. The simulated lab pitched 3 deg and
-// rolled 1 deg (3.16 deg) measures 3.15 deg with it; a real floor's cells lie within a degree.
+// rolled 1 deg (3.16 deg) measures 3.15 deg with it.
 constexpr double kLevelSpreadDeg = 3.0;
 
 // The mean of the facing cells' normals weighted by their points, twice again without
