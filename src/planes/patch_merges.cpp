@@ -139,11 +139,8 @@ constexpr double kTailDensity = 0.25;
 // Points per unit of surface (PlaneBlock::surface) of the blocks `ids`.
 double pointsPerSurface(const BlockGrid& grid, const std::vector<std::uint32_t>& ids) {
   double points = 0.0;
-  double surface = 0.0;
-  for (const std::uint32_t id : ids) {
-    points += grid.pointsOf(id).count;
-    surface += grid.blocks()[id].surface;
-  }
+  for (const std::uint32_t id : ids) points += grid.pointsOf(id).count;
+  const double surface = surfaceOf(grid, ids);
   return surface > 0.0 ? points / surface : 0.0;
 }
 
