@@ -133,27 +133,27 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   // search reaches (3DTK's corridor at 0.2 m cells, 2.9° off: a rough 2 m² patch at its far
   // end lay 0.55 m lower in z than the floor's 20 m² patch, 0.33 m below the floor's plane,
   // and the floor came out 'other').
-  const Plane* floor = nullptr;
-  const Plane* ceiling = nullptr;
-  const auto amongLowest = [&](const Plane& candidate) {
+  // The largest horizontal patch that `qualifies` (the first of equals), or none.
+  const auto largestWhere = [&](const auto& qualifies) {
+    const Plane* largest = nullptr;
+    for (const std::size_t k : horizontal) {
+      if ((largest == nullptr || planes[k].area > largest->area) && qualifies(planes[k])) largest = &planes[k];
+    }
+    return largest;
+  };
+  const Plane* floor = largestWhere([&](const Plane& candidate) {
     return std::all_of(horizontal.begin(), horizontal.end(), [&](std::size_t other) {
       return candidate.normal.dot(planes[other].centroid) + candidate.offset >= -config.floor_search;
     });
-  };
-  for (const std::size_t k : horizontal) {
-    if ((floor == nullptr || planes[k].area > floor->area) && amongLowest(planes[k])) floor = &planes[k];
-  }
+  });
   // Where every candidate's plane (up to 15° off level) puts another patch far below it, the
   // lowest in z, as before.
   if (floor == nullptr) {
     double lowest = std::numeric_limits<double>::infinity();
     for (const std::size_t k : horizontal) lowest = std::min(lowest, planes[k].centroid.z());
-    for (const std::size_t k : horizontal) {
-      if (planes[k].centroid.z() <= lowest + config.floor_search && (floor == nullptr || planes[k].area > floor->area)) {
-        floor = &planes[k];
-      }
-    }
+    floor = largestWhere([&](const Plane& candidate) { return candidate.centroid.z() <= lowest + config.floor_search; });
   }
+  const Plane* ceiling = nullptr;
   if (floor != nullptr && !surface.empty()) {
     double below = 0.0, total = 0.0;
     for (const SurfaceSample& sample : surface) {
