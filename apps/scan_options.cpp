@@ -160,7 +160,9 @@ void ScanReading::resolveUp(const std::string& up, bool level) {
     if (!z_up) {
       input.world = Pose(registration::rotationToZUp(estimate.up));
       sequence_ = io::ScanSequence(input);
-      if (level) first = firstScans();
+      // The first file as read now, without reading it again (the sequence puts the world's
+      // turn before each scan's pose).
+      for (Scan& scan : first) scan.pose = input.world * scan.pose;
     }
     if (level) levelSurfaces(first, true);
     return;
