@@ -155,6 +155,7 @@ def rot_y(deg):
 # degrees off level (3DTK's three scans: 4.3 deg of pitch and 1 deg of roll, as `mlmap
 # calibrate` finds them).
 TILT_PITCH_DEG, TILT_ROLL_DEG = 3.0, 1.0
+TILTED = ("tilt3", "tilt3level")
 
 
 def rigid(angle, shift_m, up_y, tilted=False):
@@ -347,13 +348,13 @@ def main():
     for scene, cell, cond, angle, seed in variants:
         if (scene, cell, cond, float(angle), seed) in done:
             continue
-        sim_cond = "base" if cond in ("yup", "tilt3", "tilt3level", "odom", "cloud") else cond
+        sim_cond = "base" if cond in ("yup", "odom", "cloud") + TILTED else cond
         for c in dict.fromkeys(["base", sim_cond]):  # base first: the cut scales by its points
             if (scene, c) not in sims:
                 sims[(scene, c)] = simulate(mlmap, scene, c, os.path.join(a.out, "sim"), a.resimulate)
         sim, sigma, g = sims[(scene, sim_cond)]
         shift = shift_cells(seed)
-        r, t = rigid(angle, (shift[0] * cell, shift[1] * cell), cond == "yup", cond in ("tilt3", "tilt3level"))
+        r, t = rigid(angle, (shift[0] * cell, shift[1] * cell), cond == "yup", cond in TILTED)
         tag = f"{scene}-{cell:g}-{cond}-{angle:g}deg-s{seed}"
         vdir = os.path.join(a.out, "run")
         os.makedirs(vdir, exist_ok=True)
