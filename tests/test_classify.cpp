@@ -284,3 +284,58 @@ TEST_CASE("Classes: a flight seen from below is its bands and its risers, drawer
     CHECK(drawers[k].label == PlaneClass::Other);
   }
 }
+
+TEST_CASE("Classes: a wall seen in pieces is measured over all of them, not over its outline's piece") {
+  // Bobkov's room 2 at 5 cm: a wall seen between shelves is one patch whose blocks span
+  // z 1.50-3.44 and whose outline (the largest piece) spans 2.44-3.44; it was 'other'.
+  std::vector<Plane> planes{plumbPatch(-1.7, 1.9, 3.6, 2.45, 3.44)};  // 0.99 m tall
+  std::vector<Plane> seen = planes;
+  classifyPlanes(seen);
+  CHECK(seen[0].label == PlaneClass::Other);  // as before, where nothing else is known
+  planes[0].bounds.extend(Eigen::Vector3d(-1.7, 1.9, 1.50)).extend(Eigen::Vector3d(-1.7, 3.6, 3.44));
+  classifyPlanes(planes);
+  CHECK(planes[0].label == PlaneClass::Wall);
+  // A low riser-sized piece with a stray cell far above it is no wall.
+  std::vector<Plane> low{plumbPatch(0.0, 0.0, 1.0, 0.0, 0.17)};
+  low[0].bounds.extend(Eigen::Vector3d(0.0, 0.0, 0.0)).extend(Eigen::Vector3d(0.0, 1.0, 0.9));
+  classifyPlanes(low);
+  CHECK(low[0].label != PlaneClass::Wall);
+}
+
+TEST_CASE("Classes: a cloud cut above its floor measures its tables from where its walls end") {
+  // Bobkov's room 2: cut at z 1.50, its three walls end there; the table top lies 0.68 m and
+  // the sideboard 0.47 m over it, the seats' patch (half under the table) 0.40 m. They were
+  // all 'other': without a floor nothing was measured.
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  std::vector<Plane> planes;
+  planes.push_back(levelPatch(up, {0.0, 0.0, 2.18}, 0.5, 3.5, 0.6, 2.7));    // table top
+  planes.push_back(levelPatch(up, {0.0, 0.0, 1.97}, -1.7, 0.1, -0.2, 0.9));  // sideboard
+  planes.push_back(levelPatch(up, {0.0, 0.0, 2.90}, -1.0, 0.0, 2.0, 3.0));   // a shelf 1.4 m up
+  planes.push_back(plumbPatch(4.72, -0.1, 2.9, 1.50, 3.44));
+  planes.push_back(plumbPatch(-1.70, 1.9, 3.6, 1.52, 3.44));
+  std::vector<SurfaceSample> surface;  // nothing below the cut
+  for (int k = 0; k < 100; ++k) surface.push_back({Eigen::Vector3d(0.03 * k, 0.5, 1.5 + 0.019 * k), 1.0});
+  std::vector<Plane> seen = planes;
+  classifyPlanes(seen, {}, surface);
+  CHECK(seen[0].label == PlaneClass::Table);
+  CHECK(seen[1].label == PlaneClass::Table);
+  CHECK(seen[2].label == PlaneClass::Other);
+  CHECK(seen[3].label == PlaneClass::Wall);
+  CHECK(seen[4].label == PlaneClass::Wall);
+  for (const Plane& plane : seen) CHECK(plane.label != PlaneClass::Floor);
+
+  // One wall alone, or walls whose feet disagree (seen above furniture), fix no height.
+  seen = {planes[0], planes[1], planes[3]};
+  classifyPlanes(seen, {}, surface);
+  CHECK(seen[0].label == PlaneClass::Other);
+  seen = planes;
+  seen[4] = plumbPatch(-1.70, 1.9, 3.6, 2.20, 3.44);
+  classifyPlanes(seen, {}, surface);
+  CHECK(seen[0].label == PlaneClass::Other);
+  // Walls that end together over more of the map's surface below are no floor's height.
+  std::vector<SurfaceSample> below = surface;
+  below.push_back({Eigen::Vector3d(1.0, 1.0, 0.8), 50.0});
+  seen = planes;
+  classifyPlanes(seen, {}, below);
+  CHECK(seen[0].label == PlaneClass::Other);
+}

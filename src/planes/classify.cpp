@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <numeric>
+#include <optional>
 #include <vector>
 
 namespace mlmap {
@@ -24,6 +26,37 @@ Extent extentOf(const Plane& plane) {
   }
   if (plane.outline.empty()) extent.min = extent.max = plane.centroid;
   return extent;
+}
+
+// A wall: plumb and at least wall_min_height tall, over all its pieces (Plane::bounds: a wall
+// seen between furniture is one patch of several pieces, its outline round the largest),
+// unless its largest piece is no taller than a riser: a riser's patch with a few cells of the
+// flight's higher risers in its plane (fr079 at 10 cm turned 10-25° to the grid: pieces
+// 0.9-1.1 m apart in z round a 0.2 m riser).
+bool isWall(const Plane& plane, const Extent& extent, const ClassifyConfig& config) {
+  const double largest_piece = extent.max.z() - extent.min.z();
+  const double all_pieces = plane.bounds.isEmpty() ? largest_piece : std::max(largest_piece, plane.bounds.sizes().z());
+  return isPlumb(plane.normal, config) &&
+         (largest_piece >= config.wall_min_height ||
+          (all_pieces >= config.wall_min_height && largest_piece > config.riser_max + config.level_tolerance));
+}
+
+// The height where walls end below, where two or more end together (within level_tolerance):
+// the lowest such foot, their mean. None where no two walls agree.
+std::optional<double> sharedWallFoot(const std::vector<Plane>& planes, const std::vector<Extent>& extents,
+                                     const ClassifyConfig& config) {
+  std::vector<double> feet;
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    if (!isWall(planes[k], extents[k], config)) continue;
+    feet.push_back(planes[k].bounds.isEmpty() ? extents[k].min.z() : std::min(extents[k].min.z(), planes[k].bounds.min().z()));
+  }
+  std::sort(feet.begin(), feet.end());
+  for (std::size_t k = 0; k + 1 < feet.size(); ++k) {
+    std::size_t end = k + 1;
+    while (end < feet.size() && feet[end] - feet[k] <= config.level_tolerance) ++end;
+    if (end - k >= 2) return std::accumulate(feet.begin() + static_cast<std::ptrdiff_t>(k), feet.begin() + static_cast<std::ptrdiff_t>(end), 0.0) / static_cast<double>(end - k);
+  }
+  return std::nullopt;
 }
 
 // An outline seen from above, as edges (a, b) in x and y.
@@ -154,18 +187,33 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
     floor = largestWhere([&](const Plane& candidate) { return candidate.centroid.z() <= lowest + config.floor_search; });
   }
   const Plane* ceiling = nullptr;
-  if (floor != nullptr && !surface.empty()) {
+  // Nothing lies under a floor.
+  const auto nothingBelow = [&](const Plane& level) {
     double below = 0.0, total = 0.0;
     for (const SurfaceSample& sample : surface) {
       total += sample.weight;
-      if (floor->normal.dot(sample.point) + floor->offset < -config.riser_max) below += sample.weight;
+      if (level.normal.dot(sample.point) + level.offset < -config.riser_max) below += sample.weight;
     }
-    if (below > config.floor_max_share_below * total) floor = nullptr;
+    return below <= config.floor_max_share_below * total;
+  };
+  if (floor != nullptr && !nothingBelow(*floor)) floor = nullptr;
+  // Without a floor in view, heights are measured from where the walls end below: a cloud
+  // cut above its floor (Bobkov's room 2: its three walls end at z 1.50, its table top 0.68 m
+  // and its sideboard 0.47 m over that, and they were 'other'). No patch is floor then, and
+  // no flight climbs from it.
+  Plane walls_foot;
+  const Plane* reference = floor;
+  if (floor == nullptr) {
+    if (const std::optional<double> foot = sharedWallFoot(planes, extents, config)) {
+      walls_foot.normal = Eigen::Vector3d::UnitZ();
+      walls_foot.offset = -*foot;
+      if (nothingBelow(walls_foot)) reference = &walls_foot;
+    }
   }
   // m: how far `point` lies above the floor's plane (horizontal normals point up).
-  auto aboveFloor = [&](const Eigen::Vector3d& point) { return floor->normal.dot(point) + floor->offset; };
+  auto aboveFloor = [&](const Eigen::Vector3d& point) { return reference->normal.dot(point) + reference->offset; };
   for (const std::size_t k : horizontal) {
-    if (floor != nullptr && aboveFloor(planes[k].centroid) >= config.ceiling_min_height &&
+    if (reference != nullptr && aboveFloor(planes[k].centroid) >= config.ceiling_min_height &&
         (ceiling == nullptr || planes[k].area > ceiling->area)) {
       ceiling = &planes[k];
     }
@@ -281,13 +329,14 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
   for (const std::size_t k : horizontal) {
     Plane& plane = planes[k];
     if (plane.label != PlaneClass::Other) continue;
-    const double above_floor = floor != nullptr ? aboveFloor(plane.centroid) : 0.0;
+    const double above_floor = reference != nullptr ? aboveFloor(plane.centroid) : 0.0;
     if (step[k] == 3) {
       plane.label = PlaneClass::Floor;
       if (landings != nullptr) (*landings)[k] = 1;
     } else if (step[k] == 1) {
       plane.label = PlaneClass::Step;
-    } else if (floor != nullptr && above_floor >= config.table_min_height && above_floor <= config.table_max_height) {
+    } else if (reference != nullptr && above_floor >= config.table_min_height &&
+               above_floor <= config.table_max_height) {
       plane.label = PlaneClass::Table;
     }
   }
@@ -334,7 +383,7 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
       continue;
     }
     const double height = extents[k].max.z() - extents[k].min.z();
-    if (height >= config.wall_min_height) {
+    if (isWall(plane, extents[k], config)) {
       plane.label = PlaneClass::Wall;
       continue;
     }

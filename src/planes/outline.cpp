@@ -218,4 +218,18 @@ std::vector<Eigen::Vector3d> outlineOfRuns(const std::vector<Segment>& runs, dou
   return outline;
 }
 
+std::vector<Eigen::Vector3d> cornersOfRuns(const std::vector<Segment>& runs, double cell_size,
+                                           const Eigen::Vector3d& normal, const Eigen::Vector3d& point) {
+  const RasterFrame frame(normal, point, cell_size);
+  std::vector<Eigen::Vector3d> corners;
+  corners.reserve(4 * runs.size());
+  for (const Segment& run : runs) {
+    for (const std::int32_t u : {run.u, run.u + 1}) {
+      corners.push_back(frame.corner(u, run.v_low));
+      corners.push_back(frame.corner(u, run.v_high + 1));
+    }
+  }
+  return corners;
+}
+
 }  // namespace mlmap

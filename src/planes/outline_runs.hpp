@@ -35,4 +35,13 @@ SplitPatches splitWithOutlineRuns(const BlockGrid& grid, const std::vector<std::
 std::vector<Eigen::Vector3d> outlineOfRuns(const std::vector<Segment>& runs, double cell_size,
                                            const Eigen::Vector3d& normal, const Eigen::Vector3d& point);
 
+// The runs outlineOf traces: the blocks' raster cells, `step` map cells wide.
+std::vector<Segment> runsOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
+                            const Eigen::Vector3d& normal, const Eigen::Vector3d& point, int step);
+
+// The four corners of every run on the plane: their box holds every cell of every piece of
+// a patch, where its outline rounds the largest piece only.
+std::vector<Eigen::Vector3d> cornersOfRuns(const std::vector<Segment>& runs, double cell_size,
+                                           const Eigen::Vector3d& normal, const Eigen::Vector3d& point);
+
 }  // namespace mlmap

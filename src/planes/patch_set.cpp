@@ -19,12 +19,18 @@
 namespace mlmap {
 namespace {
 
-// The outline lies on the plane the patch was split on: put it on the patch's own.
-void placeOutline(Plane& plane, const std::vector<Eigen::Vector3d>& corners) {
+// The outline lies on the plane the patch was split on: put it on the patch's own, and the
+// bounds round `cell_corners` (every piece's; cornersOfRuns) there too, or round the outline.
+void placeOutline(Plane& plane, const std::vector<Eigen::Vector3d>& corners,
+                  const std::vector<Eigen::Vector3d>& cell_corners = {}) {
+  const auto onPlane = [&](const Eigen::Vector3d& corner) -> Eigen::Vector3d {
+    return corner - plane.normal * (plane.normal.dot(corner) + plane.offset);
+  };
   plane.outline.clear();
-  for (const Eigen::Vector3d& corner : corners) {
-    plane.outline.push_back(corner - plane.normal * (plane.normal.dot(corner) + plane.offset));
-  }
+  for (const Eigen::Vector3d& corner : corners) plane.outline.push_back(onPlane(corner));
+  plane.bounds.setEmpty();
+  for (const Eigen::Vector3d& corner : cell_corners) plane.bounds.extend(onPlane(corner));
+  for (const Eigen::Vector3d& corner : plane.outline) plane.bounds.extend(corner);
 }
 
 // The area the blocks cover on the plane, not their surface: a wall on a cell boundary
@@ -283,9 +289,11 @@ void tracePendingOutlines(const BlockGrid& grid, PatchSet& set, int threads) {
     std::vector<Segment>& runs = set.outline_runs[k];
     // The split's runs are on the grid's cells: a patch sampled sparser is traced again.
     const int step = std::max(frame.step, spacingStep(grid, set.blocks[k]));
-    placeOutline(set.planes[k], runs.empty() || step > 1
-                                    ? outlineOf(grid, set.blocks[k], frame.normal, frame.point, step)
-                                    : outlineOfRuns(runs, grid.cellSize(), frame.normal, frame.point));
+    if (runs.empty() || step > 1) runs = runsOf(grid, set.blocks[k], frame.normal, frame.point, step);
+    const double raster_cell = grid.cellSize() * step;
+    placeOutline(set.planes[k], runs.empty() ? std::vector<Eigen::Vector3d>{}
+                                             : outlineOfRuns(runs, raster_cell, frame.normal, frame.point),
+                 cornersOfRuns(runs, raster_cell, frame.normal, frame.point));
     frame.pending = false;
     runs = {};
   }

@@ -303,14 +303,18 @@ std::vector<Patch> splitIntoPatches(const BlockGrid& grid, const std::vector<std
   return splitWithOutlineRuns(grid, blocks, normal, point, gap_cells, threads).patches;
 }
 
-std::vector<Eigen::Vector3d> outlineOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
-                                       const Eigen::Vector3d& normal, const Eigen::Vector3d& point, int step) {
+std::vector<Segment> runsOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
+                            const Eigen::Vector3d& normal, const Eigen::Vector3d& point, int step) {
   if (blocks.empty()) return {};
   step = std::max(step, 1);
-  const double raster_cell = grid.cellSize() * step;
-  return outlineOfRuns(
-      ColumnRuns(Footprints(grid, blocks, RasterFrame(normal, point, raster_cell), 1, step).segments, 1).runs,
-      raster_cell, normal, point);
+  return ColumnRuns(Footprints(grid, blocks, RasterFrame(normal, point, grid.cellSize() * step), 1, step).segments, 1)
+      .runs;
+}
+
+std::vector<Eigen::Vector3d> outlineOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks,
+                                       const Eigen::Vector3d& normal, const Eigen::Vector3d& point, int step) {
+  step = std::max(step, 1);
+  return outlineOfRuns(runsOf(grid, blocks, normal, point, step), grid.cellSize() * step, normal, point);
 }
 
 }  // namespace mlmap

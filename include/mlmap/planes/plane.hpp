@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <string_view>
 #include <vector>
@@ -26,6 +27,11 @@ struct Plane {
   // the riser below its top)
   double rms = 0.0;
   std::vector<Eigen::Vector3d> outline;  // m, boundary polygon on the plane, counter-clockwise
+  // m, the box round every raster cell of the patch on its plane. A patch joins pieces across
+  // small gaps (a wall seen between furniture, a sparse surface's scan lines), and its outline
+  // rounds the largest piece only: Bobkov's room 2 at 5 cm, a wall 1.9 m tall whose outline
+  // spans its top 1.0 m. Empty where unknown (planes read back from a file): then the outline's.
+  Eigen::AlignedBox3d bounds;
   std::int32_t source = 0;            // the accepted eRMSM plane it was split from (1-based)
   std::int32_t candidates = 0;        // candidates generated before that plane was accepted
 };
