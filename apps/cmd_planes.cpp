@@ -71,11 +71,15 @@ int runPlanes(const PlanesArguments& arguments, bool quiet) {
   // cut above its floor), rather than leave a user to wonder why no table is a table.
   const bool level = std::any_of(detection.planes.begin(), detection.planes.end(),
                                  [](const Plane& plane) { return isLevel(plane.normal); });
-  const bool floor = std::any_of(detection.planes.begin(), detection.planes.end(),
-                                 [](const Plane& plane) { return plane.label == PlaneClass::Floor; });
-  if (!quiet && level && !floor) {
-    std::fprintf(stderr, "note: no floor in view (the map reaches well below its lowest level patch): no patch is "
-                         "classed floor, ceiling or table\n");
+  const HeightReference& reference = detection.stats.height_reference;
+  if (!quiet && level && reference.kind == HeightReference::Kind::WallsFoot) {
+    std::fprintf(stderr,
+                 "note: no floor in view (the map reaches well below its lowest level patch): tables and the ceiling "
+                 "are measured from where the walls end below, z %.2f m; no patch is classed floor\n",
+                 reference.height);
+  } else if (!quiet && level && reference.kind == HeightReference::Kind::None) {
+    std::fprintf(stderr, "note: no floor in view (the map reaches well below its lowest level patch), and no two "
+                         "walls end at one height: no patch is classed floor, ceiling or table\n");
   }
   // A wall's worth of blocks left out by the direction-spread rule: a room's wall (on the
   // real scans of ../shared/data the largest such refusals are 0.3-4 m², but for 3DTK's

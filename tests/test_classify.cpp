@@ -316,7 +316,9 @@ TEST_CASE("Classes: a cloud cut above its floor measures its tables from where i
   std::vector<SurfaceSample> surface;  // nothing below the cut
   for (int k = 0; k < 100; ++k) surface.push_back({Eigen::Vector3d(0.03 * k, 0.5, 1.5 + 0.019 * k), 1.0});
   std::vector<Plane> seen = planes;
-  classifyPlanes(seen, {}, surface);
+  const HeightReference reference = classifyPlanes(seen, {}, surface);
+  CHECK(reference.kind == HeightReference::Kind::WallsFoot);
+  CHECK(reference.height == doctest::Approx(1.51).epsilon(1e-9));
   CHECK(seen[0].label == PlaneClass::Table);
   CHECK(seen[1].label == PlaneClass::Table);
   CHECK(seen[2].label == PlaneClass::Other);
@@ -326,7 +328,7 @@ TEST_CASE("Classes: a cloud cut above its floor measures its tables from where i
 
   // One wall alone, or walls whose feet disagree (seen above furniture), fix no height.
   seen = {planes[0], planes[1], planes[3]};
-  classifyPlanes(seen, {}, surface);
+  CHECK(classifyPlanes(seen, {}, surface).kind == HeightReference::Kind::None);
   CHECK(seen[0].label == PlaneClass::Other);
   seen = planes;
   seen[4] = plumbPatch(-1.70, 1.9, 3.6, 2.20, 3.44);

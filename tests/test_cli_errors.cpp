@@ -243,6 +243,19 @@ TEST_CASE("CLI: planes says when no floor is in view, and not when one is") {
   auto result = runCli("planes " + map);
   REQUIRE_MESSAGE(result.exit_code == 0, result.output);
   CHECK(mlmap::test::contains(result.output, "note: no floor in view"));
+  CHECK(mlmap::test::contains(result.output, "no patch is classed floor, ceiling or table"));
+  // Walls from the cut up: the table is measured from where they end.
+  mlmap::Scan walled = cut;
+  for (double x = -1.0; x <= 2.5; x += 0.01)
+    for (double z = 0.45; z <= 2.0; z += 0.01) walled.points.emplace_back(x, -0.5, z);
+  for (double y = -0.5; y <= 1.5; y += 0.01)
+    for (double z = 0.45; z <= 2.0; z += 0.01) walled.points.emplace_back(-1.0, y, z);
+  mlmap::io::writeXyz(scan, walled);
+  REQUIRE(runCli("--quiet build --identity --no-octree -o " + map + " " + scan).exit_code == 0);
+  result = runCli("planes " + map);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  CHECK(mlmap::test::contains(result.output, "measured from where the walls end below, z 0.0"));
+  CHECK(mlmap::test::contains(result.output, " table "));
   mlmap::io::writeXyz(scan, roomScan(false));
   REQUIRE(runCli("--quiet build --identity --no-octree -o " + map + " " + scan).exit_code == 0);
   result = runCli("planes " + map);

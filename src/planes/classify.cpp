@@ -147,8 +147,8 @@ std::string_view className(PlaneClass plane_class) {
   return "other";
 }
 
-void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, std::span<const SurfaceSample> surface,
-                    std::vector<std::uint8_t>* landings) {
+HeightReference classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config,
+                               std::span<const SurfaceSample> surface, std::vector<std::uint8_t>* landings) {
   if (landings != nullptr) landings->assign(planes.size(), 0);
   std::vector<std::size_t> horizontal;
   std::vector<Extent> extents;
@@ -399,6 +399,9 @@ void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config, st
       }
     }
   }
+  if (floor != nullptr) return {HeightReference::Kind::Floor, 0.0};
+  if (reference != nullptr) return {HeightReference::Kind::WallsFoot, -walls_foot.offset};
+  return {};
 }
 
 // PCL's room_scan1 at 5 cm cells: the next room's ceiling, 14.9 m² 4-5 m from the

@@ -250,7 +250,7 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   // The steps and faces cut above have no outline yet: classification reads their extents.
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));
   std::vector<std::uint8_t> landings;
-  classifyPlanes(patches.planes, {}, bottoms, &landings);
+  stats.height_reference = classifyPlanes(patches.planes, {}, bottoms, &landings);
   mergeLevels(grid, patches, radians(config.kappa_deg), sheets ? config.noise : 0.0, &landings);
   labelCeilingPieces(patches.planes, {}, landings);
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));  // the merged levels'

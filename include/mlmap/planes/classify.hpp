@@ -67,12 +67,21 @@ inline bool isPlumb(const Eigen::Vector3d& normal, const ClassifyConfig& config 
   return std::abs(normal.z()) <= std::sin(config.horizontal_deg * std::numbers::pi / 180.0);
 }
 
+// What classifyPlanes measured heights from: the floor patch, or (none in view) the lowest
+// foot two or more walls share, or nothing (no table, no ceiling then).
+struct HeightReference {
+  enum class Kind : std::uint8_t { None, Floor, WallsFoot };
+  Kind kind = Kind::None;
+  double height = 0.0;  // m: z of the walls' foot (WallsFoot); 0 otherwise
+};
+
 // Sets Plane::label for every plane. The floor is the largest horizontal patch near the
 // lowest one, unless the map's `surface` reaches below it; the ceiling the largest horizontal patch a storey above the floor.
 // A landing that a flight from the floor climbs to is floor too, at its own height:
 // `landings` (optional) gets one flag per plane, set for those.
-// Without a floor no patch is floor, ceiling or table.
-void classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config = {},
+// Without a floor, heights are measured from where two or more walls end below (a cloud cut
+// above its floor); with neither, no patch is floor, ceiling or table.
+HeightReference classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config = {},
                     std::span<const SurfaceSample> surface = {}, std::vector<std::uint8_t>* landings = nullptr);
 
 // After the floor's and the ceiling's pieces are merged (detectPlanes): a level patch a

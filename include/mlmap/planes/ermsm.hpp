@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "mlmap/map/ml_map.hpp"
+#include "mlmap/planes/classify.hpp"
 #include "mlmap/planes/plane.hpp"
 
 namespace mlmap {
@@ -131,6 +132,9 @@ struct ErmsmStats {
   // the rule (see README's weak spots); `mlmap planes` says so.
   double refused_wall_area = 0.0;
   double refused_wall_spread_deg = 0.0;
+  // What the classes measured heights from (classify.hpp): the floor, the walls' shared foot
+  // (a cloud cut above its floor; `mlmap planes` says so), or nothing.
+  HeightReference height_reference;
   double direction_seconds = 0.0;   // noise estimate, eRMSM blocks and direction vectors
   double detection_seconds = 0.0;   // Algorithm 1 with refits, patch split, merges, classes, labels
   ErmsmStageSeconds stages;         // both, split further
