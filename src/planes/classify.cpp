@@ -35,7 +35,8 @@ Extent extentOf(const Plane& plane) {
 // 0.9-1.1 m apart in z round a 0.2 m riser).
 bool isWall(const Plane& plane, const Extent& extent, const ClassifyConfig& config) {
   const double largest_piece = extent.max.z() - extent.min.z();
-  const double all_pieces = plane.bounds.isEmpty() ? largest_piece : std::max(largest_piece, plane.bounds.sizes().z());
+  const double all_pieces =
+      plane.bounds.isEmpty() ? largest_piece : std::max(largest_piece, plane.bounds.sizes().z());
   return isPlumb(plane.normal, config) &&
          (largest_piece >= config.wall_min_height ||
           (all_pieces >= config.wall_min_height && largest_piece > config.riser_max + config.level_tolerance));
@@ -48,13 +49,16 @@ std::optional<double> sharedWallFoot(const std::vector<Plane>& planes, const std
   std::vector<double> feet;
   for (std::size_t k = 0; k < planes.size(); ++k) {
     if (!isWall(planes[k], extents[k], config)) continue;
-    feet.push_back(planes[k].bounds.isEmpty() ? extents[k].min.z() : std::min(extents[k].min.z(), planes[k].bounds.min().z()));
+    const double foot = extents[k].min.z();
+    feet.push_back(planes[k].bounds.isEmpty() ? foot : std::min(foot, planes[k].bounds.min().z()));
   }
   std::sort(feet.begin(), feet.end());
   for (std::size_t k = 0; k + 1 < feet.size(); ++k) {
     std::size_t end = k + 1;
     while (end < feet.size() && feet[end] - feet[k] <= config.level_tolerance) ++end;
-    if (end - k >= 2) return std::accumulate(feet.begin() + static_cast<std::ptrdiff_t>(k), feet.begin() + static_cast<std::ptrdiff_t>(end), 0.0) / static_cast<double>(end - k);
+    if (end - k < 2) continue;
+    const auto first = feet.begin() + static_cast<std::ptrdiff_t>(k);
+    return std::accumulate(first, feet.begin() + static_cast<std::ptrdiff_t>(end), 0.0) / static_cast<double>(end - k);
   }
   return std::nullopt;
 }

@@ -82,7 +82,8 @@ struct HeightReference {
 // Without a floor, heights are measured from where two or more walls end below (a cloud cut
 // above its floor); with neither, no patch is floor, ceiling or table.
 HeightReference classifyPlanes(std::vector<Plane>& planes, const ClassifyConfig& config = {},
-                    std::span<const SurfaceSample> surface = {}, std::vector<std::uint8_t>* landings = nullptr);
+                               std::span<const SurfaceSample> surface = {},
+                               std::vector<std::uint8_t>* landings = nullptr);
 
 // After the floor's and the ceiling's pieces are merged (detectPlanes): a level patch a
 // storey above the largest floor and within `riser_max` of the largest ceiling's plane
