@@ -291,8 +291,7 @@ void tracePendingOutlines(const BlockGrid& grid, PatchSet& set, int threads) {
     const int step = std::max(frame.step, spacingStep(grid, set.blocks[k]));
     if (runs.empty() || step > 1) runs = runsOf(grid, set.blocks[k], frame.normal, frame.point, step);
     const double raster_cell = grid.cellSize() * step;
-    placeOutline(set.planes[k], runs.empty() ? std::vector<Eigen::Vector3d>{}
-                                             : outlineOfRuns(runs, raster_cell, frame.normal, frame.point),
+    placeOutline(set.planes[k], outlineOfRuns(runs, raster_cell, frame.normal, frame.point),
                  cornersOfRuns(runs, raster_cell, frame.normal, frame.point));
     frame.pending = false;
     runs = {};
