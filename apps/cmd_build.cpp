@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "commands.hpp"
+#include "mlmap/error.hpp"
 #include "mlmap/io/map_file.hpp"
 #include "mlmap/map/map.hpp"
 #include "mlmap/registration/sequence_registration.hpp"
@@ -61,8 +62,20 @@ int runBuild(const BuildOptions& options, bool quiet) {
   const auto start = std::chrono::steady_clock::now();
   Progress progress("build", options.input.scans.size(), !quiet);
   std::size_t point_count = 0;
+  const double octree_resolution = config.octree_resolution > 0.0 ? config.octree_resolution : config.cell_size;
   const io::ScanInputCounts counts = reading.forEach(
-      [&](Scan& scan, std::size_t, std::size_t) {
+      [&](Scan& scan, std::size_t index, std::size_t file) {
+        // OctoMap's keys reach ±32,768 voxels: beyond, its rays are dropped without a word,
+        // and a cloud in a national grid's coordinates gave an empty OcTree.
+        if (const double farthest = farthestCoordinate(scan);
+            config.with_octree && farthest >= keyReach(octree_resolution)) {
+          char text[200];
+          std::snprintf(text, sizeof(text), "reaches %.0f m from the origin, beyond the %.0f m the OcTree's keys reach at %g m voxels",
+                        farthest, keyReach(octree_resolution), octree_resolution);
+          throw Error(options.input.scans[file] + " (scan " + std::to_string(index + 1) + "): it " + text +
+                      "; move the clouds nearer the origin (subtract a corner of a national grid's "
+                      "coordinates), or build the block layer alone with --no-octree");
+        }
         if (scan.variances.empty() && options.range_sigma > 0.0) {
           scan.variances.assign(scan.size(), options.range_sigma * options.range_sigma);
         }

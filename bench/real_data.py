@@ -183,7 +183,7 @@ def build_map(mlmap, folder, cell, files, pose_file, up_options, features):
     tag = os.path.join(folder, f"cell{cell:g}")
     # The benchmark drops a scanner's own and no-return readings itself (real_clouds.py),
     # so mlmap's range limits are opened wide.
-    wide = (["--max-range", "1000"] if "--max-range" in features["build"] else []) + \
+    wide = (["--max-range", "1e9"] if "--max-range" in features["build"] else []) + \
            (["--min-range", "0"] if "--min-range" in features["build"] else [])
     build = [mlmap, "-q", "build", "-o", tag + ".mlmap", "--cell-size", str(cell), "--no-octree"] + \
         posed_options(pose_file, features) + up_options + wide
@@ -211,7 +211,7 @@ def run_mlmap(mlmap, scene, folder, cell, files, pose_file, up_options, features
     if "--up" in features["label"]:
         label += up_options  # so that label places the points in the frame of the map's planes
     if "--max-range" in features["label"]:
-        label += ["--max-range", "1000"]  # every input point keeps its line: labels come in input order
+        label += ["--max-range", "1e9"]  # every input point keeps its line: labels come in input order
     if "--min-range" in features["label"]:
         label += ["--min-range", "0"]
     if "--json" in features["label"]:

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -26,5 +27,21 @@ struct Scan {
   }
   Point worldPoint(std::size_t index) const { return pose * points[index]; }
 };
+
+// m: how far from the world's origin along an axis a scan reaches, its points (world frame)
+// and its sensor: the OcTree's and the registration's keys (OctoMap's, 16 bits a side) reach
+// 32,768 voxels either way, which a cloud in a national grid's coordinates lies beyond.
+inline double farthestCoordinate(const std::vector<Point>& points, const Pose& pose) {
+  double farthest = pose.translation().cwiseAbs().maxCoeff();
+  for (const Point& point : points) {
+    const Point p = pose * point;
+    if (p.allFinite()) farthest = std::max(farthest, p.cwiseAbs().maxCoeff());
+  }
+  return farthest;
+}
+inline double farthestCoordinate(const Scan& scan) { return farthestCoordinate(scan.points, scan.pose); }
+
+// m: the reach of a key grid of 16 bits a side (OctoMap's) at this voxel size.
+inline double keyReach(double voxel_size) { return 32768.0 * voxel_size; }
 
 }  // namespace mlmap

@@ -1,6 +1,7 @@
 #include "mlmap/planes/block_grid.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <limits>
 
 #include "fill_vector.hpp"
@@ -117,6 +118,15 @@ BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_siz
   }
   rows_ = max_i - min_i_ + 1;
   columns_ = max_j - min_j_ + 1;
+  // Float keeps 24 bits: past 2^13 cells from the origin its unit in the last place is over
+  // a thousandth of a cell (0.05 m cells: 410 m out). Maps that near keep the map's frame
+  // (their planes to the bit as before); farther ones are centred.
+  constexpr std::int64_t kFloatSafeCells = std::int64_t{1} << 13;
+  const std::int64_t farthest = std::max({std::abs(min_i_), std::abs(max_i + 1), std::abs(min_j_), std::abs(max_j + 1)});
+  if (farthest > kFloatSafeCells) {
+    origin_i_ = min_i_ + (max_i - min_i_) / 2;
+    origin_j_ = min_j_ + (max_j - min_j_) / 2;
+  }
   // A building at a few centimetres fits easily; a map spread over kilometres does not.
   constexpr std::int64_t kMaxGridCells = std::int64_t{1} << 28;
   if (rows_ > kMaxGridCells / columns_) {
@@ -139,7 +149,7 @@ BlockGrid::BlockGrid(const MLMap& map, const BlockGridConfig& config) : cell_siz
     const auto map_cell = static_cast<std::size_t>(grid[position]);
     map_cell_.push_back(static_cast<std::uint32_t>(map_cell));
     const CellIndex cell = map.cellAt(map_cell);
-    appendStacks(map.blocksAt(map_cell), cell, map.cellCenter(cell), cell_size_, rule, blocks_);
+    appendStacks(map.blocksAt(map_cell), cell, cellCentre(cell), cell_size_, rule, blocks_);
     cell_first_.push_back(static_cast<std::uint32_t>(blocks_.size()));
   }
   first_id_from_.back() = static_cast<std::uint32_t>(blocks_.size());

@@ -53,7 +53,7 @@ struct Footprints {
     if (frame.on_map_grid) {
 #pragma omp parallel for schedule(static) num_threads(std::max(threads, 1)) if (parallel)
       for (std::int64_t k = 0; k < count; ++k) {
-        const CellIndex cell = grid.blocks()[blocks[static_cast<std::size_t>(k)]].cell;
+        const CellIndex cell = grid.localCell(grid.blocks()[blocks[static_cast<std::size_t>(k)]].cell);
         const auto u = static_cast<std::int32_t>(floorDivide(cell.i, step));
         const auto v = static_cast<std::int32_t>(floorDivide(cell.j, step));
         segments[static_cast<std::size_t>(k)] = {u, v, v};

@@ -108,9 +108,14 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     plane_of_slot[slot] = &plane;
     origin[slot] = plane.centroid.allFinite() ? plane.centroid : Eigen::Vector3d::Zero();
     fitted[slot].id = plane.id;
-    fitted[slot].normal = plane.normal.allFinite() && plane.normal.norm() > 0.0 ? plane.normal.normalized()
-                                                                               : Eigen::Vector3d::UnitZ();
-    fitted[slot].offset = std::isfinite(plane.offset) ? plane.offset : 0.0;
+    // The normal and the offset scaled together: a normal found in float is unit to 1e-7,
+    // and scaled alone it moves the plane by that share of its distance from the origin (a
+    // cloud in a national grid's coordinates, 5,000 km out: 0.1-0.5 m, and a wall lost its
+    // points).
+    const double length = plane.normal.allFinite() ? plane.normal.norm() : 0.0;
+    const bool usable = length > 0.0 && std::isfinite(plane.offset);
+    fitted[slot].normal = usable ? Eigen::Vector3d(plane.normal / length) : Eigen::Vector3d::UnitZ();
+    fitted[slot].offset = usable ? plane.offset / length : 0.0;
     const double rms = std::isfinite(plane.rms) ? plane.rms : 0.0;
     const double sigma = options.noise > 0.0 ? std::min(rms, options.noise) : rms;
     fitted[slot].tolerance = std::max(options.min_tolerance, options.sigmas * sigma);

@@ -4,7 +4,7 @@
 // point of it: a block's cell is where its point projects. A level plane (a floor, a
 // ceiling, a table top, a step) is rasterised on the map's own grid seen from above
 // instead: a block's cell is the map cell it lies in, with u its row i and v its column
-// j. Its blocks, numbered row by row over the grid, then come in raster order already,
+// j, counted from the grid's origin cell (BlockGrid::localCell). Its blocks, numbered row by row over the grid, then come in raster order already,
 // so the split sorts nothing, and no point is projected. A plane is level where
 // planeBasis cannot take u = z × n (|z × n| < kLevelSine, within 17.5° of level): there
 // a cell of the grid is at most 1.05 times longer on the plane than on its own raster,

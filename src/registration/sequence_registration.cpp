@@ -4,9 +4,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <string>
 
 #include "mlmap/error.hpp"
 #include "mlmap/registration/floor_calibration.hpp"
@@ -102,6 +104,17 @@ SequenceRegistration::SequenceRegistration(const SequenceConfig& config)
     : config_(config), map_(config.map_voxel_size, config.max_points_per_voxel) {}
 
 VerifiedIcp SequenceRegistration::addScan(const std::vector<Point>& points, const Pose& odometry) {
+  // The map's and the pairs' voxel keys reach ±32,768 voxels (OctoMap's): points beyond
+  // are never matched, and a cloud in a national grid's coordinates registered nothing.
+  const double reach = keyReach(std::min(config_.map_voxel_size, config_.pair_voxel_size));
+  if (const double farthest = farthestCoordinate(points, odometry); farthest >= reach) {
+    char text[160];
+    std::snprintf(text, sizeof(text), "scan %zu reaches %.0f m from the origin, beyond the %.0f m",
+                  poses_.size() + 1, farthest, reach);
+    throw Error(std::string(text) +
+                " the registration's voxel keys reach; move the clouds nearer the origin (subtract a "
+                "corner of a national grid's coordinates)");
+  }
   // The map and the local maps take a finer sample than the ICP source: their normals
   // need neighbours.
   const std::vector<Point> dense =

@@ -79,7 +79,25 @@ class BlockGrid {
   // centre (cellCentre); empty for a map without point moments. The map the grid was
   // made from must still be alive.
   PointStats pointsOf(std::uint32_t id) const;
-  Eigen::Vector2d cellCentre(CellIndex cell) const { return {(cell.j + 0.5) * cell_size_, (cell.i + 0.5) * cell_size_}; }
+  // Where cell `cell`'s centre is in the grid's frame: the map's, moved by origin() where
+  // the map lies far from its own origin (see there).
+  Eigen::Vector2d cellCentre(CellIndex cell) const {
+    return {(static_cast<double>(std::int64_t{cell.j} - origin_j_) + 0.5) * cell_size_,
+            (static_cast<double>(std::int64_t{cell.i} - origin_i_) + 0.5) * cell_size_};
+  }
+  // Where the grid's frame (block points, cellCentre, pointsFrameOf, and the planes found
+  // on them) has its origin in the map's: zero, or a cell corner amid the map where its
+  // cells lie so far out that float coordinates, which the blocks' points are kept in,
+  // would round by more than a thousandth of a cell (a cloud in a national grid, x 500 km and
+  // y 5,000 km: rounded to 3 and 50 cm). Planes found on the grid move back by it.
+  Eigen::Vector3d origin() const {
+    return {static_cast<double>(origin_j_) * cell_size_, static_cast<double>(origin_i_) * cell_size_, 0.0};
+  }
+  // The cell's index counted from the cell at origin(): the map grid's raster of a level
+  // plane (raster_frame.hpp) is in these.
+  CellIndex localCell(CellIndex cell) const {
+    return {static_cast<std::int32_t>(cell.i - origin_i_), static_cast<std::int32_t>(cell.j - origin_j_)};
+  }
   // The frame pointsOf(id) is in: block `id`'s cell centre at z 0 (its points' mean is
   // this plus PointStats::mean()).
   Eigen::Vector3d pointsFrameOf(std::uint32_t id) const {
@@ -127,6 +145,8 @@ class BlockGrid {
   std::vector<std::uint32_t> first_id_from_;
   std::int64_t min_i_ = 0;
   std::int64_t min_j_ = 0;
+  std::int64_t origin_i_ = 0;  // the cell whose lower corner is origin()
+  std::int64_t origin_j_ = 0;
   std::int64_t rows_ = 0;
   std::int64_t columns_ = 0;
 };
