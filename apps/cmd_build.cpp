@@ -47,7 +47,8 @@ std::vector<io::StampedPose> registeredPoses(const BuildOptions& options, const 
       [&](std::size_t file) { progress.update(file + 1); });
   sequence.refine();
   progress.finish();
-  for (std::size_t i = 0; i < corrected.size(); ++i) corrected[i].pose = sequence.poses()[i];
+  const std::vector<Pose> poses = sequence.poses();
+  for (std::size_t i = 0; i < corrected.size(); ++i) corrected[i].pose = poses[i];
   return corrected;
 }
 
@@ -63,18 +64,31 @@ int runBuild(const BuildOptions& options, bool quiet) {
   Progress progress("build", options.input.scans.size(), !quiet);
   std::size_t point_count = 0;
   const double octree_resolution = config.octree_resolution > 0.0 ? config.octree_resolution : config.cell_size;
+  bool first = true;
   const io::ScanInputCounts counts = reading.forEach(
       [&](Scan& scan, std::size_t index, std::size_t file) {
+        // A cloud far from the origin (a national grid's coordinates) is mapped near it: the
+        // first scan sets the map's origin, stored with the map; the commands give planes
+        // and points back in the world's coordinates.
+        if (first) {
+          map.setOrigin(chooseOrigin(scan, keyReach(octree_resolution)));
+          first = false;
+          if (!map.config().origin.isZero() && !quiet)
+            std::fprintf(stderr, "build: the scans lie far from the origin: the map's frame has its origin at "
+                                 "(%.0f, %.0f, %.0f) m (planes and labels come back in the scans' coordinates)\n",
+                         map.config().origin.x(), map.config().origin.y(), map.config().origin.z());
+        }
+        scan.pose.pretranslate(-map.config().origin);
         // OctoMap's keys reach ±32,768 voxels: beyond, its rays are dropped without a word,
         // and a cloud in a national grid's coordinates gave an empty OcTree.
         if (const double farthest = farthestCoordinate(scan);
             config.with_octree && farthest >= keyReach(octree_resolution)) {
           char text[200];
-          std::snprintf(text, sizeof(text), "reaches %.0f m from the origin, beyond the %.0f m the OcTree's keys reach at %g m voxels",
+          std::snprintf(text, sizeof(text), "lies %.0f m from the map's origin, beyond the %.0f m the OcTree's keys reach at %g m voxels",
                         farthest, keyReach(octree_resolution), octree_resolution);
           throw Error(options.input.scans[file] + " (scan " + std::to_string(index + 1) + "): it " + text +
-                      "; move the clouds nearer the origin (subtract a corner of a national grid's "
-                      "coordinates), or build the block layer alone with --no-octree");
+                      " (the first scan set the origin); map the scans apart and merge the maps, or build the "
+                      "block layer alone with --no-octree");
         }
         if (scan.variances.empty() && options.range_sigma > 0.0) {
           scan.variances.assign(scan.size(), options.range_sigma * options.range_sigma);

@@ -90,7 +90,7 @@ int runExport(const ExportArguments& arguments, bool quiet) {
     done("planes JSON", arguments.json);
   }
   if (page) {
-    io::writeDashboard(arguments.dashboard, *page, io::planesJson(map, *map.planes(), source),
+    io::writeDashboard(arguments.dashboard, *page, io::planesJson(map, *map.planes(), source, true),
                        io::dashboardBlocks(map.blocks()),
                        arguments.dashboard_voxels ? io::dashboardVoxels(map) : std::string());
     done("dashboard", (std::filesystem::path(arguments.dashboard) / "index.html").string());

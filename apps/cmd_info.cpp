@@ -27,8 +27,11 @@ int runInfo(const std::string& path, bool as_json) {
                     {"horizontal", stats.horizontal_blocks},
                     {"vertical", stats.vertical_blocks},
                     {"labelled", stats.labelled_blocks}};
-  info["bounds"] = {{"min", {stats.min.x(), stats.min.y(), stats.min.z()}},
-                    {"max", {stats.max.x(), stats.max.y(), stats.max.z()}}};
+  // In the world's coordinates; the map holds them moved by −origin (MapConfig::origin).
+  const Eigen::Vector3d& origin = map.config().origin;
+  const Eigen::Vector3d low = stats.min + origin, high = stats.max + origin;
+  info["bounds"] = {{"min", {low.x(), low.y(), low.z()}}, {"max", {high.x(), high.y(), high.z()}}};
+  if (!origin.isZero()) info["origin"] = {origin.x(), origin.y(), origin.z()};
   info["memory_bytes"] = {{"blocks", stats.memory_bytes}};
   const double bytes_per_block =
       stats.blocks == 0 ? 0.0 : static_cast<double>(stats.memory_bytes) / static_cast<double>(stats.blocks);
@@ -68,8 +71,11 @@ int runInfo(const std::string& path, bool as_json) {
   std::printf("  cells          %zu\n", stats.cells);
   std::printf("  blocks         %zu (%zu horizontal, %zu vertical, %zu labelled)\n", stats.blocks,
               stats.horizontal_blocks, stats.vertical_blocks, stats.labelled_blocks);
-  std::printf("  bounds         x %.2f..%.2f  y %.2f..%.2f  z %.2f..%.2f m\n", stats.min.x(),
-              stats.max.x(), stats.min.y(), stats.max.y(), stats.min.z(), stats.max.z());
+  if (!origin.isZero())
+    std::printf("  origin         (%.2f, %.2f, %.2f) m: the map's frame in the scans' (its OcTree and block "
+                "exports are in the map's frame)\n", origin.x(), origin.y(), origin.z());
+  std::printf("  bounds         x %.2f..%.2f  y %.2f..%.2f  z %.2f..%.2f m\n", low.x(), high.x(), low.y(),
+              high.y(), low.z(), high.z());
   std::printf("  block memory   %.1f MB (%.1f bytes/block)\n", static_cast<double>(stats.memory_bytes) / 1e6,
               bytes_per_block);
   if (summary.octree) {

@@ -38,8 +38,11 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
     throw Error(arguments.map + ": the map has no planes; run `mlmap planes " + arguments.map +
                 " -o LABELLED.mlmap` and label with that map");
   }
-  Scan labelled;  // all points, world frame
-  std::vector<Point> scanner_positions;       // per scan, world frame
+  // The map's frame (MapConfig::origin: a map of a cloud far from the origin): points are
+  // labelled there and written back in the scans' coordinates.
+  const Eigen::Vector3d& origin = map.config().origin;
+  Scan labelled;  // all points, the map's frame
+  std::vector<Point> scanner_positions;       // per scan, the map's frame
   std::vector<std::uint32_t> scan_of_point;  // per point
   std::vector<bool> outside_range;           // per point
   std::size_t with_plane = 0;
@@ -48,6 +51,7 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
       [&](Scan& scan, std::size_t index, std::size_t file) {
         // The build refused such a scan: with other limits here every point would be "none".
         io::requireReadingsInRange(scan, arguments.input.range, arguments.input.scans[file], index);
+        scan.pose.pretranslate(-origin);
         const std::vector<std::int32_t> labels = labelPoints(map.blocks(), scan);
         const auto scan_index = static_cast<std::uint32_t>(scanner_positions.size());
         scanner_positions.push_back(scan.pose.translation());
@@ -73,12 +77,14 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
     if (label <= 0 || outside_range[k]) label = -1;
     with_plane += label > 0 ? 1 : 0;
   }
-  io::writeXyz(arguments.output, labelled);
   if (!arguments.json.empty()) {
     const PlaneDetection refitted{refitToPoints(map.planes()->planes, labelled.points, labelled.labels),
                                   map.planes()->stats, map.planes()->config};
     io::writePlanesJson(arguments.json, map, refitted, arguments.map);
   }
+  if (!origin.isZero())
+    for (Point& point : labelled.points) point += origin;
+  io::writeXyz(arguments.output, labelled);
   std::printf("%s: %zu points, %zu on a plane (%.1f %%)\n", arguments.output.c_str(), labelled.size(),
               with_plane, labelled.size() == 0 ? 0.0 : 100.0 * static_cast<double>(with_plane) / static_cast<double>(labelled.size()));
   return 0;

@@ -47,6 +47,15 @@ int runMerge(const MergeArguments& arguments, bool quiet) {
   const Map other = io::readMap(arguments.other);
   Pose other_to_base = Pose::Identity();
   if (!arguments.transform.empty()) other_to_base = io::readTransform(arguments.transform);
+  // Transforms are given and printed between the maps' world frames (the scans'); the maps
+  // hold their blocks moved by −origin (MapConfig::origin: a map far from the origin).
+  const Eigen::Vector3d base_origin = base.config().origin, other_origin = other.config().origin;
+  const auto toMaps = [&](const Pose& world) {
+    return Pose(Eigen::Translation3d(-base_origin) * world * Eigen::Translation3d(other_origin));
+  };
+  const auto toWorld = [&](const Pose& maps) {
+    return Pose(Eigen::Translation3d(base_origin) * maps * Eigen::Translation3d(-other_origin));
+  };
 
   std::printf("merge %s + %s\n", arguments.base.c_str(), arguments.other.c_str());
   if (arguments.register_maps) {
@@ -55,7 +64,8 @@ int runMerge(const MergeArguments& arguments, bool quiet) {
     const auto icp_start = std::chrono::steady_clock::now();
     registration::MapRegistrationConfig config;
     config.max_tilt_deg = arguments.max_tilt_deg;
-    const registration::MapRegistration found = registration::registerMaps(base, other, initial, config);
+    registration::MapRegistration found = registration::registerMaps(base, other, toMaps(initial), config);
+    found.other_to_base = toWorld(found.other_to_base);
     printTransform("initial guess", initial);
     printTransform("registered   ", found.other_to_base);
     std::printf("  ICP: %zu of %zu surface samples matched, RMS %.2f cm, overlap %.1f %%, %.2f s%s\n", found.inliers,
@@ -81,12 +91,14 @@ int runMerge(const MergeArguments& arguments, bool quiet) {
 
   if (!quiet) std::fprintf(stderr, "merge: fusing blocks and OcTrees ...\n");
   const auto merge_start = std::chrono::steady_clock::now();
-  const MergeStats stats = mergeInto(base, other, other_to_base, arguments.max_tilt_deg);
+  const MergeStats stats = mergeInto(base, other, toMaps(other_to_base), arguments.max_tilt_deg);
   const double merge_seconds = seconds(merge_start);
   io::writeMap(arguments.output, base);
   if (!arguments.write_transform.empty()) {
     double tilt_deg = 0.0;
-    io::writeTransform(arguments.write_transform, levelledTransform(other_to_base, tilt_deg));
+    // Levelled as the merge levelled it: about the maps' frames, not the world's (a tilt
+    // about a point 5,000 km away is a shift of kilometres).
+    io::writeTransform(arguments.write_transform, toWorld(levelledTransform(toMaps(other_to_base), tilt_deg)));
   }
   std::printf("  blocks: %zu + %zu -> %zu (%zu fewer than the sum: overlap fused)\n", stats.base_blocks,
               stats.other_blocks, stats.merged_blocks, stats.base_blocks + stats.other_blocks - stats.merged_blocks);

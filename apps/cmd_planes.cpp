@@ -64,8 +64,8 @@ int runPlanes(const PlanesArguments& arguments, bool quiet) {
   for (const Plane& plane : detection.planes) {
     std::printf("  %4d %-8s %8.2f %8zu %7.2f  (%6.3f, %6.3f, %6.3f) %8.3f %8d\n", plane.id,
                 std::string(className(plane.label)).c_str(), plane.area, plane.block_count,
-                100.0 * plane.rms, plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.offset,
-                plane.candidates);
+                100.0 * plane.rms, plane.normal.x(), plane.normal.y(), plane.normal.z(),
+                plane.offset - plane.normal.dot(map.config().origin), plane.candidates);  // the world's
   }
   // Classes are heights above the floor: say when there is none to measure from (a cloud
   // cut above its floor), rather than leave a user to wonder why no table is a table.
@@ -76,7 +76,7 @@ int runPlanes(const PlanesArguments& arguments, bool quiet) {
     std::fprintf(stderr,
                  "note: no floor in view (the map reaches well below its lowest level patch): tables and the ceiling "
                  "are measured from where the walls end below, z %.2f m; no patch is classed floor\n",
-                 reference.height);
+                 reference.height + map.config().origin.z());
   } else if (!quiet && level && reference.kind == HeightReference::Kind::None) {
     std::fprintf(stderr, "note: no floor in view (the map reaches well below its lowest level patch), and no two "
                          "walls end at one height: no patch is classed floor, ceiling or table\n");

@@ -97,7 +97,8 @@ int runRegister(RegisterOptions options, bool quiet) {
                 refine_seconds);
   }
   if (!options.report.empty()) writeRegisterReport(options.report, reports, options.no_refine ? nullptr : &refinement);
-  for (std::size_t i = 0; i < stamped.size(); ++i) stamped[i].pose = sequence.poses()[i];
+  const std::vector<Pose> poses = sequence.poses();
+  for (std::size_t i = 0; i < stamped.size(); ++i) stamped[i].pose = poses[i];
   io::writeTumPoses(options.output, stamped);
   std::printf("%s: %zu scans, %zu points; scan-to-map %.3f s per scan, refinement %.2f s\n",
               options.output.c_str(), stamped.size(), point_count,

@@ -1,11 +1,13 @@
 // A cloud in a national grid's coordinates (x 500 km, y 5,000 km, heights of hundreds of
-// metres) is mapped, its planes found and its points labelled as near the origin; where a
-// layer's keys cannot reach it (the OcTree's, the registration's), the command says so.
+// metres) is mapped, registered, its planes found and its points labelled as near the
+// origin: the map and the registration work in a frame near the cloud, and give the cloud's
+// own coordinates back.
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -145,41 +147,94 @@ TEST_CASE("Far from the origin: blocks 300 m up, a cell apart, are read back in 
 }
 
 // Failed before: the registration's voxel keys (OctoMap's, ±32,768 voxels) dropped every
-// point, and `register` reported 0 inliers and kept the odometry, as if it had tried.
-TEST_CASE("Far from the origin: registration says the scans lie beyond its keys' reach") {
-  registration::SequenceRegistration sequence;
-  Pose far = Pose::Identity();
-  far.translation() = kNationalGrid;
-  const std::vector<Point> points = {Point(1.0, 0.0, 0.0), Point(0.0, 2.0, 0.0), Point(0.0, 0.0, 1.0)};
-  try {
-    sequence.addScan(points, far);
-    FAIL("no error");
-  } catch (const Error& error) {
-    CHECK(std::string(error.what()).find("nearer the origin") != std::string::npos);
-  }
+// point, and `register` reported 0 inliers and kept the odometry, as if it had tried. Now the
+// sequence runs in a frame near its first scan and gives the same poses as near the origin.
+TEST_CASE("Far from the origin: a sequence registers as near the origin, its poses in the scans' coordinates") {
+  sim::Scene scene = sim::parseScene(kBoxRoomJson, "box_room.json");
+  const std::vector<sim::SimulatedScan> scans = sim::simulate(scene);
+  REQUIRE(scans.size() == 2);
+  Pose start = scans[1].scan.pose;  // the second scan starts 5 cm and 1 deg off
+  start.pretranslate(Eigen::Vector3d(0.05, -0.03, 0.0));
+  start.rotate(Eigen::AngleAxisd(std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()));
+  const auto run = [&](const Eigen::Vector3d& shift) {
+    registration::SequenceRegistration sequence;
+    Pose first = scans[0].scan.pose, second = start;
+    first.pretranslate(shift);
+    second.pretranslate(shift);
+    sequence.addScan(scans[0].scan.points, first);
+    const registration::VerifiedIcp result = sequence.addScan(scans[1].scan.points, second);
+    CHECK(result.verified);
+    CHECK((result.start.translation() - second.translation()).norm() < 1e-6);  // the world's, as given
+    return sequence.poses();
+  };
+  const std::vector<Pose> near_origin = run(Eigen::Vector3d::Zero());
+  const std::vector<Pose> far_out = run(kNationalGrid);
+  REQUIRE(far_out.size() == 2);
+  CHECK((far_out[1].translation() - kNationalGrid - scans[1].scan.pose.translation()).norm() < 0.01);
+  CHECK((far_out[1].translation() - kNationalGrid - near_origin[1].translation()).norm() < 1e-4);
+  const double turn = Eigen::AngleAxisd(far_out[1].linear().transpose() * near_origin[1].linear()).angle();
+  CHECK(turn < 1e-4);  // rad
 }
 
-// Failed before: the OcTree's rays were dropped without a word, and the map held an empty
-// OcTree. Now the build stops, says why and names --no-octree, which maps the blocks.
-TEST_CASE("Far from the origin: build says the OcTree cannot reach the cloud, and maps it with --no-octree") {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mlmap_far_origin_test";
-  std::filesystem::create_directories(dir);
+// Failed before: the OcTree's rays were dropped without a word and the map held an empty
+// OcTree, the planes lost walls and classes, and the map could not be read back. Now the
+// build puts the map's origin near the cloud, stores it, and `info`, `planes --json` and
+// `label` speak the cloud's own coordinates; a scan beyond the OcTree's reach from that origin
+// is refused with a message.
+TEST_CASE("Far from the origin: build, planes and label of a cloud in a national grid's coordinates") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "mlmap_far_origin_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // A floor and a wall, 4 m by 3 m, 1 cm apart, at (500 km, 5,000 km), 300 m up.
   const std::string scan = (dir / "far.xyz").string();
   {
     std::ofstream out(scan);
-    for (int k = 0; k < 200; ++k) out << std::fixed << 500000.0 + 0.01 * k << " " << 5000000.0 << " " << 300.0 << "\n";
+    out << std::fixed;
+    for (int a = 0; a < 400; ++a)
+      for (int b = 0; b < 300; ++b) {
+        out << 500000.0 + 0.01 * a << " " << 5000000.0 + 0.01 * b << " " << 300.0 << "\n";
+        if (b < 250) out << 500000.0 + 0.01 * a << " " << 5000003.0 << " " << 300.0 + 0.01 * b << "\n";
+      }
   }
-  const std::string map = (dir / "far.mlmap").string();
-  std::filesystem::remove(map);
-  const auto refused = test::runCli("--quiet build --identity --min-range 0 --max-range 1e7 -o " + map + " " + scan);
-  CHECK(refused.exit_code == 1);
-  CHECK(refused.output.find("beyond the 3277 m the OcTree's keys reach") != std::string::npos);
-  CHECK(refused.output.find("--no-octree") != std::string::npos);
-  CHECK_FALSE(std::filesystem::exists(map));
-  const auto built =
-      test::runCli("--quiet build --identity --no-octree --min-range 0 --max-range 1e7 -o " + map + " " + scan);
-  CHECK_MESSAGE(built.exit_code == 0, built.output);
+  const std::string map = (dir / "far.mlmap").string(), planes = (dir / "far.planes.mlmap").string();
+  const auto built = test::runCli("--quiet build --identity --min-range 0 --max-range 1e7 -o " + map + " " + scan);
+  REQUIRE_MESSAGE(built.exit_code == 0, built.output);
   const auto info = test::runCli("info " + map);
-  CHECK_MESSAGE(info.exit_code == 0, info.output);
-  std::filesystem::remove_all(dir);
+  CHECK(info.output.find("origin         (500000.00, 5000000.00, 300.00) m") != std::string::npos);
+  CHECK(info.output.find("x 500000.00..500004.00") != std::string::npos);
+  CHECK(info.output.find("0 nodes") == std::string::npos);  // the OcTree holds the cloud
+  const auto found = test::runCli("--quiet planes " + map + " -o " + planes + " --json " + (dir / "p.json").string());
+  REQUIRE_MESSAGE(found.exit_code == 0, found.output);
+  std::ifstream json_file(dir / "p.json");
+  const std::string json((std::istreambuf_iterator<char>(json_file)), std::istreambuf_iterator<char>());
+  CHECK(json.find("\"origin\":[500000.0,5000000.0,300.0]") != std::string::npos);
+  CHECK(json.find("\"label\":\"floor\"") != std::string::npos);
+  CHECK(json.find("\"label\":\"wall\"") != std::string::npos);
+  const auto labelled = test::runCli("--quiet label " + planes + " --identity --min-range 0 --max-range 1e7 -o " +
+                                     (dir / "l.xyz").string() + " " + scan);
+  REQUIRE_MESSAGE(labelled.exit_code == 0, labelled.output);
+  std::ifstream labels(dir / "l.xyz");
+  double x = 0.0, y = 0.0, z = 0.0;
+  int label = 0, on_plane = 0, total = 0;
+  while (labels >> x >> y >> z >> label) {
+    ++total;
+    on_plane += label > 0 ? 1 : 0;
+    if (total == 1) CHECK(x == doctest::Approx(500000.0).epsilon(1e-12));
+  }
+  CHECK(total == 400 * 300 + 400 * 250);
+  CHECK(on_plane > 0.95 * total);
+  // A second scan 3 km from the first lies beyond the OcTree's reach from the origin the
+  // first set (1,638 m at 5 cm voxels).
+  const std::string farther = (dir / "farther.xyz").string();
+  {
+    std::ofstream out(farther);
+    out << std::fixed << 503000.0 << " " << 5000000.0 << " " << 300.0 << "\n";
+  }
+  const auto refused = test::runCli("--quiet build --cell-size 0.05 --identity --min-range 0 --max-range 1e7 -o " +
+                                    (dir / "two.mlmap").string() + " " + scan + " " + farther);
+  CHECK(refused.exit_code == 1);
+  CHECK(refused.output.find("beyond the 1638 m the OcTree's keys reach") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "two.mlmap"));
+  fs::remove_all(dir);
 }

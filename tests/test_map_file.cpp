@@ -8,6 +8,7 @@
 #include "helpers.hpp"
 #include "mlmap/error.hpp"
 #include "mlmap/io/map_file.hpp"
+#include "mlmap/io/planes_json.hpp"
 
 using namespace mlmap;
 
@@ -15,21 +16,25 @@ namespace {
 
 // A version-3 file's bytes in an older version's layout: each block without its 40
 // bytes of point moments, the version byte set, the checksum made anew.
-std::string olderLayout(const std::string& v3, char version) {
+// A version-4 file's bytes in an older layout: without the origin (version 3 and before),
+// and without the blocks' point moments (versions 1-2).
+std::string olderLayout(const std::string& v4, char version) {
   constexpr std::size_t kHeader = 8 + 4 + 4 + 3 * 8;
+  constexpr std::size_t kOrigin = 3 * 8;
   std::uint64_t cells = 0;
-  std::memcpy(&cells, v3.data() + kHeader, sizeof(cells));
-  std::string out = v3.substr(0, kHeader + 16);
+  std::memcpy(&cells, v4.data() + kHeader + kOrigin, sizeof(cells));
+  std::string out = v4.substr(0, kHeader) + v4.substr(kHeader + kOrigin, 16);
   out[8] = version;
-  std::size_t at = kHeader + 16;
+  std::size_t at = kHeader + kOrigin + 16;
+  const std::size_t kept = version >= 3 ? 57 : 17;
   for (std::uint64_t c = 0; c < cells; ++c) {
     std::uint16_t count = 0;
-    std::memcpy(&count, v3.data() + at + 8, sizeof(count));
-    out.append(v3, at, 10);
+    std::memcpy(&count, v4.data() + at + 8, sizeof(count));
+    out.append(v4, at, 10);
     at += 10;
-    for (std::uint16_t k = 0; k < count; ++k, at += 57) out.append(v3, at, 17);
+    for (std::uint16_t k = 0; k < count; ++k, at += 57) out.append(v4, at, kept);
   }
-  out.append(v3, at, v3.size() - 4 - at);
+  out.append(v4, at, v4.size() - 4 - at);
   const std::uint32_t crc = io::crc32(out.data(), out.size());
   out.append(reinterpret_cast<const char*>(&crc), sizeof(crc));
   return out;
@@ -140,7 +145,7 @@ TEST_CASE("MapFile: damaged, truncated, foreign and future files are refused by 
   SUBCASE("a hostile cell count with a valid checksum") {
     std::string hostile = good.substr(0, good.size() - 4);
     const std::uint64_t huge = 1ULL << 60;
-    std::memcpy(hostile.data() + 40, &huge, sizeof(huge));
+    std::memcpy(hostile.data() + 64, &huge, sizeof(huge));
     const std::uint32_t crc = io::crc32(hostile.data(), hostile.size());
     hostile.append(reinterpret_cast<const char*>(&crc), sizeof(crc));
     test::writeText(dir / "hostile.mlmap", hostile);
@@ -203,6 +208,12 @@ TEST_CASE("MapFile: a labelled map keeps its planes, and version-1 files still r
   const Map old = io::readMap(dir / "v1.mlmap");
   CHECK_FALSE(old.planes().has_value());
   CHECK(old.blocks().blockCount() == unlabelled.blocks().blockCount());
+  // Version 3: the version-4 layout without the map's origin (the world's).
+  test::writeText(dir / "v3-layout.mlmap", olderLayout(test::readText(dir / "v3.mlmap"), 3));
+  const Map v3 = io::readMap(dir / "v3-layout.mlmap");
+  CHECK(v3.blocks().blockCount() == unlabelled.blocks().blockCount());
+  CHECK_FALSE(v3.blocks().blocksAt(0)[0].points.empty());
+  CHECK(v3.config().origin.isZero());
 
   // New scans invalidate the labels.
   Map changed = io::readMap(dir / "labelled.mlmap");
@@ -211,6 +222,44 @@ TEST_CASE("MapFile: a labelled map keeps its planes, and version-1 files still r
   changed.insertScan(scan);
   CHECK_FALSE(changed.planes().has_value());
   CHECK(changed.blocks().stats().labelled_blocks == 0);
+}
+
+// The origin of a map far from the world's (a national grid's coordinates) is kept, and its
+// planes, stored in the world's coordinates, come back in the map's frame.
+TEST_CASE("MapFile: a map's origin is kept and its planes come back in its frame") {
+  const test::TempDir dir;
+  Map map = smallRoomMap(false);
+  Map far(map.config());
+  const Eigen::Vector3d origin(500000.0, 5000000.0, 300.0);
+  far.setOrigin(origin);
+  Scan scan;
+  scan.points = {Point(0.5, 0.5, 0.0), Point(0.6, 0.5, 0.0)};
+  far.insertScan(scan);
+  CHECK_THROWS_AS(far.setOrigin(Eigen::Vector3d::Zero()), Error);  // not once it holds a scan
+  PlaneDetection detection;
+  Plane plane;
+  plane.id = 1;
+  plane.normal = Eigen::Vector3d::UnitZ();
+  plane.offset = -0.25;  // z = 0.25 in the map's frame
+  plane.area = 1.0;
+  plane.block_count = 2;
+  plane.source = 1;
+  plane.centroid = Eigen::Vector3d(0.5, 0.5, 0.25);
+  plane.outline = {{0, 0, 0.25}, {1, 0, 0.25}, {1, 1, 0.25}};
+  detection.planes.push_back(plane);
+  far.setPlanes(detection);
+  io::writeMap(dir / "far.mlmap", far);
+  const Map back = io::readMap(dir / "far.mlmap");
+  CHECK(back.config().origin.isApprox(origin));
+  REQUIRE(back.planes().has_value());
+  const Plane& read = back.planes()->planes[0];
+  CHECK(read.offset == doctest::Approx(-0.25).epsilon(1e-9));
+  CHECK(read.centroid.isApprox(Eigen::Vector3d(0.5, 0.5, 0.25), 1e-9));
+  CHECK(read.outline[1].isApprox(Eigen::Vector3d(1, 0, 0.25), 1e-9));
+  // The planes JSON speaks the world's coordinates.
+  const std::string json = io::planesJson(back, *back.planes(), "far.mlmap");
+  CHECK(json.find("\"centroid\":[500000.5,5000000.5,300.25]") != std::string::npos);
+  CHECK(json.find("\"origin\":[500000.0,5000000.0,300.0]") != std::string::npos);
 }
 
 TEST_CASE("MapFile: CRC-32 is zlib's (IEEE 802.3), also taken in pieces") {

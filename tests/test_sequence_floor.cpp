@@ -111,7 +111,7 @@ TEST_CASE("SequenceRegistration: a scan with a strip of floor too small for its 
   SequenceRegistration& sequence = run.sequence;
   const std::vector<mlmap::Pose>& truth = run.truth;
   sequence.refine();
-  const mlmap::Pose& one = sequence.poses()[1];
+  const mlmap::Pose one = sequence.poses()[1];
   const double height_error = (one.translation() - truth[1].translation()).z() -
                               (sequence.poses()[0].translation() - truth[0].translation()).z();
   const TrajectoryError error = trajectoryError(sequence.poses(), truth);

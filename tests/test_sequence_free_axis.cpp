@@ -53,7 +53,7 @@ TEST_CASE("SequenceRegistration: a scan left free along a corridor is placed by 
   SequenceRegistration sequence(asRegister());
   sequence.addScan(scans[0].scan.points, scans[0].true_pose);
   const VerifiedIcp result = sequence.addScan(scans[1].scan.points, odometry);
-  const mlmap::Pose& found = sequence.poses()[1];
+  const mlmap::Pose found = sequence.poses()[1];
   const double along = found.translation().x() - scans[1].true_pose.translation().x();
   CAPTURE(along);
   CAPTURE(result.reason);

@@ -14,8 +14,14 @@ void writeBlocksPly(const std::filesystem::path& path, const Map& map) {
   if (map.planes()) {
     for (const Plane& plane : map.planes()->planes) normals[plane.id] = plane.normal.cast<float>();
   }
+  // In the map's frame: float x y z hold a national grid's coordinates to half a metre only.
+  const Eigen::Vector3d& origin = map.config().origin;
+  const std::string origin_comment =
+      origin.isZero() ? std::string()
+                      : "comment in the map's frame, whose origin lies at " + std::to_string(origin.x()) + " " +
+                            std::to_string(origin.y()) + " " + std::to_string(origin.z()) + " m\n";
   std::string out = "ply\nformat binary_little_endian 1.0\ncomment mlmap blocks, cell size " +
-                    std::to_string(blocks.cellSize()) + " m\nelement vertex " +
+                    std::to_string(blocks.cellSize()) + " m\n" + origin_comment + "element vertex " +
                     std::to_string(blocks.blockCount()) +
                     "\nproperty float x\nproperty float y\nproperty float z\n"
                     "property float nx\nproperty float ny\nproperty float nz\n"

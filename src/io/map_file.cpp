@@ -94,6 +94,7 @@ void writeMap(const std::filesystem::path& path, const Map& map) {
   put<double>(out, config.cell_size);
   put<double>(out, config.octree_resolution);
   put<double>(out, config.max_range);
+  for (int axis = 0; axis < 3; ++axis) put<double>(out, config.origin[axis]);
   std::uint64_t non_empty_cells = 0;
   for (std::size_t n = 0; n < blocks.cellCount(); ++n) non_empty_cells += !blocks.blocksAt(n).empty();
   put<std::uint64_t>(out, non_empty_cells);
@@ -207,6 +208,12 @@ Map readMapFile(const std::filesystem::path& path, MapSummary* summary) {
   config.cell_size = in.get<double>("the cell size");
   config.octree_resolution = in.get<double>("the OcTree resolution");
   config.max_range = in.get<double>("the maximum range");
+  if (version >= 4) {
+    for (int axis = 0; axis < 3; ++axis) config.origin[axis] = in.get<double>("the origin");
+    if (!(config.origin.allFinite() && config.origin.cwiseAbs().maxCoeff() < 1e9)) {
+      in.failAt(40, "the origin is not a finite point within 10^9 m");
+    }
+  }
   config.with_octree = (flags & kHasOctree) != 0;
   const bool has_planes = (flags & kHasPlanes) != 0;
   if ((flags & ~(kHasOctree | kHasPlanes)) != 0 || (has_planes && version < 2)) {
@@ -305,7 +312,11 @@ Map readMapFile(const std::filesystem::path& path, MapSummary* summary) {
     }
     const std::size_t planes_offset = in.offset();
     try {
-      map.setPlanes(parsePlanesJson(in.take(planes_size, "the planes"), "the planes"));
+      PlaneDetection planes = parsePlanesJson(in.take(planes_size, "the planes"), "the planes");
+      // Written in the world's coordinates (planesJson), kept in the map's frame.
+      if (!config.origin.isZero())
+        for (Plane& plane : planes.planes) movePlane(plane, -config.origin);
+      map.setPlanes(std::move(planes));
     } catch (const Error& error) {
       in.failAt(planes_offset, error.what());
     }

@@ -42,8 +42,10 @@ const char* cityJsonName(PlaneClass plane_class) {
 
 }  // namespace
 
-std::string planesJson(const Map& map, const PlaneDetection& detection, const std::string& source_name) {
+std::string planesJson(const Map& map, const PlaneDetection& detection, const std::string& source_name,
+                       bool in_map_frame) {
   const MLMapStats stats = map.blocks().stats();
+  const Eigen::Vector3d shift = in_map_frame ? Eigen::Vector3d::Zero() : map.config().origin;
   const ErmsmConfig& config = detection.config;
   nlohmann::json json;
   json["schema"] = kPlanesSchema;
@@ -51,7 +53,8 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
                  {"cell_size", map.config().cell_size},
                  {"cells", stats.cells},
                  {"blocks", stats.blocks},
-                 {"bounds", {{"min", position(stats.min)}, {"max", position(stats.max)}}}};
+                 {"bounds", {{"min", position(stats.min + shift)}, {"max", position(stats.max + shift)}}}};
+  if (!map.config().origin.isZero()) json["map"]["origin"] = position(map.config().origin);
   json["parameters"] = {{"radius_cells", config.radius},
                         {"epsilon", asFloat(config.epsilon)},
                         {"max_epsilon", asFloat(std::max(config.epsilon, config.max_epsilon))},
@@ -97,7 +100,9 @@ std::string planesJson(const Map& map, const PlaneDetection& detection, const st
                      {"merges_s", run.stages.merges},
                      {"labels_s", run.stages.labels}};
   nlohmann::json planes = nlohmann::json::array();
-  for (const Plane& plane : detection.planes) {
+  for (const Plane& in_map : detection.planes) {
+    Plane plane = in_map;
+    if (!shift.isZero()) movePlane(plane, shift);
     nlohmann::json outline = nlohmann::json::array();
     for (const Eigen::Vector3d& corner : plane.outline) outline.push_back(position(corner));
     nlohmann::json entry = {{"id", plane.id},

@@ -47,6 +47,13 @@ void Map::insertIntoOctree(const Scan& scan) {
   detail::insertRays(*octree_, scan, {config_.max_range, config_.exact_rays});
 }
 
+void Map::setOrigin(const Eigen::Vector3d& origin) {
+  if (blocks_.blockCount() > 0 || (octree_ && octree_->size() > 0))
+    throw Error("the map's origin can only be set before its first scan");
+  if (!origin.allFinite()) throw Error("the map's origin must be a finite point");
+  config_.origin = origin;
+}
+
 void Map::compact() {
   blocks_.compact();
   if (octree_) octree_->prune();

@@ -92,15 +92,6 @@ struct BlockField {
 // A level rung is fused from a few points (under ten): its variance is a good part of
 // one point's σ², a table top's far below it; σ the build's, in which the blocks'
 // variances are, not the one measured on the planes.
-// The plane moved by `shift`: from a frame whose origin lies at `shift` to the one that
-// frame is in.
-void movePlane(Plane& plane, const Eigen::Vector3d& shift) {
-  plane.offset -= plane.normal.dot(shift);
-  plane.centroid += shift;
-  for (Eigen::Vector3d& corner : plane.outline) corner += shift;
-  if (!plane.bounds.isEmpty()) plane.bounds.translate(shift);
-}
-
 BlockGridConfig gridConfig(const ErmsmConfig& config, double block_noise) {
   return BlockGridConfig{.stack_gap = config.stack_gap,
                          .level_band = 5.0 * config.noise,

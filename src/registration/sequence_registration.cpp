@@ -103,17 +103,18 @@ Matrix6d icpInformation(const IcpResult& result, double min_sigma, double min_ei
 SequenceRegistration::SequenceRegistration(const SequenceConfig& config)
     : config_(config), map_(config.map_voxel_size, config.max_points_per_voxel) {}
 
-VerifiedIcp SequenceRegistration::addScan(const std::vector<Point>& points, const Pose& odometry) {
+VerifiedIcp SequenceRegistration::addScan(const std::vector<Point>& points, const Pose& world_odometry) {
   // The map's and the pairs' voxel keys reach ±32,768 voxels (OctoMap's): points beyond
   // are never matched, and a cloud in a national grid's coordinates registered nothing.
+  // The sequence runs in a frame whose origin the first scan sets (chooseOrigin).
   const double reach = keyReach(std::min(config_.map_voxel_size, config_.pair_voxel_size));
+  if (poses_.empty()) origin_ = chooseOrigin(points, world_odometry, reach);
+  const Pose odometry = Eigen::Translation3d(-origin_) * world_odometry;
   if (const double farthest = farthestCoordinate(points, odometry); farthest >= reach) {
     char text[160];
-    std::snprintf(text, sizeof(text), "scan %zu reaches %.0f m from the origin, beyond the %.0f m",
+    std::snprintf(text, sizeof(text), "scan %zu lies %.0f m from the first, beyond the %.0f m",
                   poses_.size() + 1, farthest, reach);
-    throw Error(std::string(text) +
-                " the registration's voxel keys reach; move the clouds nearer the origin (subtract a "
-                "corner of a national grid's coordinates)");
+    throw Error(std::string(text) + " the registration's voxel keys reach from where the first scan lies");
   }
   // The map and the local maps take a finer sample than the ICP source: their normals
   // need neighbours.
@@ -164,7 +165,14 @@ VerifiedIcp SequenceRegistration::addScan(const std::vector<Point>& points, cons
   poses_.push_back(pose);
   chain_.push_back(pose);
   levelled_.push_back(levelled);
+  for (Pose* world : {&result.start, &result.kept_start, &result.icp.pose}) world->pretranslate(origin_);
   return result;
+}
+
+std::vector<Pose> SequenceRegistration::poses() const {
+  std::vector<Pose> world = poses_;
+  for (Pose& pose : world) pose.pretranslate(origin_);
+  return world;
 }
 
 std::optional<SequenceRegistration::Floor> SequenceRegistration::floorOf(const std::vector<Point>& source) const {

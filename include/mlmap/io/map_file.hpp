@@ -5,6 +5,7 @@
 //   version    u32      kMapFileVersion
 //   flags      u32      bit 0: an OcTree follows, bit 1: planes follow (version ≥ 2)
 //   cell_size, octree_resolution, max_range   f64 each, metres
+//   origin     x y z f64 each, metres (version ≥ 4: MapConfig::origin; 0 before)
 //   cell_count u64, block_count u64
 //   per cell:  i i32, j i32, n u16, then n blocks: h f32, σ f32, d f32, π i32, kind u8,
 //              and from version 3 the points' moments: count u32, mean x y z f32 (x, y
@@ -25,8 +26,10 @@
 namespace mlmap::io {
 
 // 1: no planes section; 2: no point moments per block (both still read, their blocks
-// then sit at their cell centres for plane detection).
-constexpr std::uint32_t kMapFileVersion = 3;
+// then sit at their cell centres for plane detection); 3: no origin (the world's).
+// The planes section holds the planes in the world's coordinates, as `mlmap planes --json`
+// writes them; the map keeps them in its own frame.
+constexpr std::uint32_t kMapFileVersion = 4;
 
 // Written to a temporary file and renamed: a failure leaves any old file untouched.
 void writeMap(const std::filesystem::path& path, const Map& map);

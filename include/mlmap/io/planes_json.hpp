@@ -15,8 +15,13 @@ namespace mlmap::io {
 constexpr const char* kPlanesSchema = "mlmap.planes/1";
 
 // The export as JSON text: a member per line, a plane per line, positions (centroids,
-// outlines) rounded to the micrometre.
-std::string planesJson(const Map& map, const PlaneDetection& detection, const std::string& source_name);
+// outlines) rounded to the micrometre. Planes and bounds in the world's coordinates, or
+// with `in_map_frame` in the map's (the dashboard: a national grid's coordinates are too
+// large for a browser's float); map.origin says where the map's frame lies, where it is
+// not the world's (`detection` holds the planes in the map's frame, as detectPlanes
+// found them).
+std::string planesJson(const Map& map, const PlaneDetection& detection, const std::string& source_name,
+                       bool in_map_frame = false);
 
 // Written atomically.
 void writePlanesJson(const std::filesystem::path& path, const Map& map, const PlaneDetection& detection,

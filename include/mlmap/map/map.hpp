@@ -21,6 +21,12 @@ struct MapConfig {
   // OcTree rays: false = one ray per voxel holding end points, to its centre (OctoMap's
   // insertPointCloud with discretize = true); true = one ray per point (discretize = false).
   bool exact_rays = false;
+  // m: where the map's frame has its origin in the world (the scans' poses' frame). The map
+  // holds its points moved by −origin: a cloud in a national grid's coordinates (x 500 km,
+  // y 5,000 km) lies beyond the OcTree's keys (±32,768 voxels) and rounds in the blocks'
+  // float, so `mlmap build` moves it near the origin (chooseOrigin) and the commands give
+  // planes and points back in the world's coordinates. Zero for maps near the origin.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
 };
 
 class Map {
@@ -37,6 +43,8 @@ class Map {
   void compact();
 
   const MapConfig& config() const { return config_; }
+  // Sets MapConfig::origin; only before any scan was inserted (throws mlmap::Error after).
+  void setOrigin(const Eigen::Vector3d& origin);
   const MLMap& blocks() const { return blocks_; }
   MLMap& blocks() { return blocks_; }
   bool hasOctree() const { return octree_ != nullptr; }

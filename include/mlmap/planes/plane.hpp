@@ -36,4 +36,13 @@ struct Plane {
   std::int32_t candidates = 0;        // candidates generated before that plane was accepted
 };
 
+// The plane moved by `shift`: from a frame whose origin lies at `shift` into the one that
+// frame lies in (a map's frame into the world's: MapConfig::origin), or back with −shift.
+inline void movePlane(Plane& plane, const Eigen::Vector3d& shift) {
+  plane.offset -= plane.normal.dot(shift);
+  plane.centroid += shift;
+  for (Eigen::Vector3d& corner : plane.outline) corner += shift;
+  if (!plane.bounds.isEmpty()) plane.bounds.translate(shift);
+}
+
 }  // namespace mlmap

@@ -107,7 +107,10 @@ class SequenceRegistration {
   // every scan's residuals against the others (RefinementResult).
   RefinementResult refine();
 
-  const std::vector<Pose>& poses() const { return poses_; }
+  // World frame, as the odometry given to addScan (the sequence itself runs in a frame the
+  // first scan sets: origin()).
+  std::vector<Pose> poses() const;
+  const Eigen::Vector3d& origin() const { return origin_; }
   // Whether scan `index` was levelled on its floor (level_from_floor) after its ICP.
   bool levelledOnFloor(std::size_t index) const { return index < levelled_.size() && levelled_[index]; }
   const SequenceConfig& config() const { return config_; }
@@ -124,6 +127,9 @@ class SequenceRegistration {
                                                  const std::vector<double>& source_noise) const;
 
   SequenceConfig config_;
+  // m: where the sequence's frame lies in the world: zero, or near the first scan where it
+  // lies far from the world's origin (chooseOrigin: a national grid's coordinates).
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
   VoxelHashMap map_;
   std::vector<Pose> odometry_;
   std::vector<Pose> poses_;
