@@ -47,15 +47,14 @@ int runMerge(const MergeArguments& arguments, bool quiet) {
   const Map other = io::readMap(arguments.other);
   Pose other_to_base = Pose::Identity();
   if (!arguments.transform.empty()) other_to_base = io::readTransform(arguments.transform);
-  // Transforms are given and printed between the maps' world frames (the scans'); the maps
-  // hold their blocks moved by −origin (MapConfig::origin: a map far from the origin).
-  const Eigen::Vector3d base_origin = base.config().origin, other_origin = other.config().origin;
-  const auto toMaps = [&](const Pose& world) {
-    return Pose(Eigen::Translation3d(-base_origin) * world * Eigen::Translation3d(other_origin));
-  };
-  const auto toWorld = [&](const Pose& maps) {
-    return Pose(Eigen::Translation3d(base_origin) * maps * Eigen::Translation3d(-other_origin));
-  };
+  // The maps hold their blocks moved by −origin (MapConfig::origin: a map far from the
+  // world's origin). Transforms are given and printed about the base map's origin: the
+  // world's for maps near it, and for two maps of a national grid's coordinates a turn
+  // about the site rather than about a point 5,000 km away (kilometres of translation). The
+  // other map's blocks are moved by the difference of the origins first.
+  const Eigen::Vector3d origins_apart = other.config().origin - base.config().origin;
+  const auto toMaps = [&](const Pose& given) { return Pose(given * Eigen::Translation3d(origins_apart)); };
+  const auto toWorld = [&](const Pose& maps) { return Pose(maps * Eigen::Translation3d(-origins_apart)); };
 
   std::printf("merge %s + %s\n", arguments.base.c_str(), arguments.other.c_str());
   if (arguments.register_maps) {
@@ -96,8 +95,7 @@ int runMerge(const MergeArguments& arguments, bool quiet) {
   io::writeMap(arguments.output, base);
   if (!arguments.write_transform.empty()) {
     double tilt_deg = 0.0;
-    // Levelled as the merge levelled it: about the maps' frames, not the world's (a tilt
-    // about a point 5,000 km away is a shift of kilometres).
+    // Levelled as the merge levelled it, in the maps' frames.
     io::writeTransform(arguments.write_transform, toWorld(levelledTransform(toMaps(other_to_base), tilt_deg)));
   }
   std::printf("  blocks: %zu + %zu -> %zu (%zu fewer than the sum: overlap fused)\n", stats.base_blocks,
@@ -121,7 +119,8 @@ void addMergeCommand(CLI::App& app, Context& context) {
   command->add_option("-o,--output", arguments->output, "The merged map (.mlmap)")->required();
   auto* transform = command->add_option(
       "--transform", arguments->transform,
-      "other -> base transform: 'x y z yaw_deg', 'x y z qx qy qz qw' or a 4x4 matrix (default: same frame)")
+      "other -> base transform: 'x y z yaw_deg', 'x y z qx qy qz qw' or a 4x4 matrix (default: same frame); "
+      "about the base map's origin (`mlmap info`: the world's unless the map lies far from it)")
       ->check(CLI::ExistingFile);
   auto* register_flag = command->add_flag("--register", arguments->register_maps,
                                           "Find the transform by ICP between the maps' surfaces");

@@ -83,9 +83,15 @@ ScanReading::ScanReading(const ScanOptions& options, const char* command, bool q
   resolveUp(options.up, options.level);
 }
 
-std::vector<Scan> ScanReading::firstScans() const {
+std::vector<Scan> ScanReading::firstScans(Eigen::Vector3d* shift) const {
   std::vector<Scan> first;
   read([&](Scan& scan, std::size_t, std::size_t) { first.push_back(std::move(scan)); }, {}, 1);
+  // Up and tilt are directions: judged near the origin, where the voxel keys that find the
+  // planar cells reach (a national grid's coordinates lie beyond them, and a cloud there read
+  // as y-up). As far as the map would be moved (chooseOrigin at 5 cm voxels).
+  const Eigen::Vector3d moved = first.empty() ? Eigen::Vector3d::Zero() : chooseOrigin(first.front(), keyReach(0.05));
+  for (Scan& scan : first) scan.pose.pretranslate(-moved);
+  if (shift != nullptr) *shift = moved;
   return first;
 }
 
@@ -135,9 +141,11 @@ void ScanReading::resolveUp(const std::string& up, bool level) {
   // auto, or the default: look at the first file, and at every pose of a pose file (the
   // turns of a sequence of one-scan files: the first file alone has none, and one tilting-laser
   // scan of a narrow room faces its long walls more than its floor).
-  std::vector<Scan> first = firstScans();
+  Eigen::Vector3d shift;
+  std::vector<Scan> first = firstScans(&shift);
   std::vector<Pose> poses;
-  for (const io::StampedPose& stamped : sequence_.poses()) poses.push_back(input.world * stamped.pose);
+  for (const io::StampedPose& stamped : sequence_.poses())
+    poses.push_back(Eigen::Translation3d(-shift) * input.world * stamped.pose);
   const registration::UpAxisEstimate estimate = registration::estimateUpAxis(first, {}, poses);
   const bool z_up = estimate.up.z() > 0.5;
   const std::string evidence =

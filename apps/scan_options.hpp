@@ -53,7 +53,9 @@ class ScanReading {
  private:
   void resolveUp(const std::string& up, bool level);
   // The first file's scans, in the world frame as turned so far.
-  std::vector<Scan> firstScans() const;
+  // The first file's scans, moved near the origin where they lie far from it (`shift`: by how
+  // much, the move subtracted).
+  std::vector<Scan> firstScans(Eigen::Vector3d* shift = nullptr) const;
   // Turns the world so that the first file's level surfaces face +z exactly (--level), or
   // warns where they lean over kWarnTiltDeg and no --level was given.
   void levelSurfaces(const std::vector<Scan>& first, bool level);

@@ -224,6 +224,25 @@ TEST_CASE("Far from the origin: build, planes and label of a cloud in a national
   }
   CHECK(total == 400 * 300 + 400 * 250);
   CHECK(on_plane > 0.95 * total);
+  // The same cloud 150 m further east has its own origin (500,200 m); merged in the scans'
+  // frame (no transform), it lands 150 m east of the first, not at its origin.
+  const std::string east = (dir / "east.xyz").string();
+  {
+    std::ifstream in(scan);
+    std::ofstream out(east);
+    out << std::fixed;
+    while (in >> x >> y >> z) out << x + 150.0 << " " << y << " " << z << "\n";
+  }
+  const auto east_built = test::runCli("--quiet build --identity --min-range 0 --max-range 1e7 -o " +
+                                       (dir / "east.mlmap").string() + " " + east);
+  REQUIRE_MESSAGE(east_built.exit_code == 0, east_built.output);
+  CHECK(test::runCli("info " + (dir / "east.mlmap").string()).output.find("origin         (500200.00") !=
+        std::string::npos);
+  const auto merged = test::runCli("--quiet merge " + map + " " + (dir / "east.mlmap").string() + " -o " +
+                                   (dir / "both.mlmap").string());
+  REQUIRE_MESSAGE(merged.exit_code == 0, merged.output);
+  CHECK(test::runCli("info " + (dir / "both.mlmap").string()).output.find("x 500000.00..500154.00") !=
+        std::string::npos);
   // A second scan 3 km from the first lies beyond the OcTree's reach from the origin the
   // first set (1,638 m at 5 cm voxels).
   const std::string farther = (dir / "farther.xyz").string();
