@@ -20,6 +20,7 @@ io::ScanInput inputOf(const ScanOptions& options) {
   input.poses = options.poses;
   input.identity = options.identity;
   input.range = options.range;
+  input.scale = options.units == "mm" ? 0.001 : options.units == "cm" ? 0.01 : 1.0;
   input.isolated = options.isolated;
   return input;
 }
@@ -68,6 +69,10 @@ void addScanOptions(CLI::App* command, ScanOptions& options, const ScanOptionSet
                       "The data's up axis, turned to +z before mapping: x y z -x -y -z, or auto to detect it "
                       "(default: z, with a warning when the data look otherwise)")
       ->check(CLI::IsMember({"x", "y", "z", "-x", "-y", "-z", "+x", "+y", "+z", "auto"}));
+  command->add_option("--units", options.units,
+                      "Units of the scans' coordinates and the pose file's positions: m, cm or mm (default m; 3DTK's "
+                      ".3d files are converted from their centimetres as they are read: leave m for them)")
+      ->check(CLI::IsMember({"m", "cm", "mm"}));
   command->add_flag("--level", options.level,
                     "Turn the data so that their level surfaces (floors, ceilings, found in the first file) face +z "
                     "exactly, after --up's turn: a scanner standing a few degrees off level, whose walls otherwise "

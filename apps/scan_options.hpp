@@ -24,6 +24,7 @@ struct ScanOptions {
   std::string mount;  // from `mlmap calibrate`
   std::string up;     // x y z -x -y -z auto; empty: z, with a warning when the data disagree
   bool level = false; // turn the level surfaces exactly to +z (after --up's turn)
+  std::string units = "m";  // m cm mm: of the files' coordinates and the pose file's positions
 };
 
 struct ScanOptionSet {

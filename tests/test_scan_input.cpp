@@ -160,3 +160,25 @@ TEST_CASE("Scan input: a scan with readings but none within the range limits is 
   unknown.points.emplace_back(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0);
   CHECK_NOTHROW(io::requireReadingsInRange(unknown, io::RangeLimits{}, "nan.xyz", 0));
 }
+
+// Failed before (no --units): a room scanned in millimetres lies 1,000 times too far, every
+// reading beyond 30 m, and the message only offered a wider range, which maps a room of
+// kilometres. Now the message names --units mm, and the scale turns file and pose file to metres.
+TEST_CASE("Scan input: coordinates in millimetres, read with a scale, and named in the range error") {
+  test::TempDir dir;
+  Scan room = scanWithJunk();
+  for (Point& point : room.points) point *= 1000.0;
+  io::writeXyz(dir / "mm.xyz", room);
+  io::writeTumPoses(dir / "poses.txt", {{0.0, poseAt(2000.0, 90.0)}});
+  const std::string message = test::errorOf([&] { io::requireReadingsInRange(room, io::RangeLimits{}, "mm.xyz", 0); });
+  CHECK(test::contains(message, "if its coordinates are millimetres, --units mm"));
+  io::ScanInput input{.files = {dir / "mm.xyz"}, .poses = dir / "poses.txt"};
+  input.scale = 0.001;
+  const io::ScanSequence sequence(input);
+  std::vector<Scan> read;
+  const io::ScanInputCounts counts = sequence.forEach([&](Scan& scan, std::size_t, std::size_t) { read.push_back(scan); });
+  CHECK(counts.points == 50);  // the wall, as in metres; the housing and the no-returns dropped
+  REQUIRE(read.size() == 1);
+  CHECK(read[0].points[0].isApprox(Point(3.0, -1.0, 0.5), 1e-9));
+  CHECK(read[0].pose.isApprox(poseAt(2.0, 90.0), 1e-9));
+}

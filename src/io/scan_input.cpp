@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "mlmap/error.hpp"
 #include "kept_readings.hpp"
@@ -27,12 +29,14 @@ void requireReadingsInRange(const Scan& scan, const RangeLimits& limits, const s
                             std::size_t index) {
   double nearest = std::numeric_limits<double>::infinity();
   double farthest = 0.0;
+  std::vector<double> ranges;
   for (const Point& point : scan.points) {
     if (limits.contains(point)) return;
     const double range = point.norm();
     if (!std::isfinite(range)) continue;
     nearest = std::min(nearest, range);
     farthest = std::max(farthest, range);
+    ranges.push_back(range);
   }
   if (!(farthest >= nearest)) return;  // no finite readings: the reader's to judge
   char text[320];
@@ -40,7 +44,18 @@ void requireReadingsInRange(const Scan& scan, const RangeLimits& limits, const s
                 ": none of its %zu readings lies within %g-%g m of the scanner (they lie %.4g-%.4g m from it); a "
                 "cloud registered in another frame, read without a pose, needs --min-range 0 --max-range %.4g",
                 scan.size(), limits.min, limits.max, nearest, farthest, std::ceil(farthest + 1.0));
-  throw Error(file.string() + " (scan " + std::to_string(index + 1) + ")" + text);
+  // A cloud in millimetres or centimetres puts a room's readings 1,000 or 100 times too far:
+  // its median reading would lie within the limits (a scanner's junk aside) and over a metre.
+  std::string units;
+  const auto middle = ranges.begin() + static_cast<std::ptrdiff_t>(ranges.size() / 2);
+  std::nth_element(ranges.begin(), middle, ranges.end());
+  const double median = *middle;
+  for (const auto& [name, scale] : {std::pair{"mm", 0.001}, std::pair{"cm", 0.01}}) {
+    if (units.empty() && limits.contains(Point(median * scale, 0.0, 0.0)) && median * scale > 1.0)
+      units = std::string("; or, if its coordinates are ") + (scale == 0.001 ? "millimetres" : "centimetres") +
+              ", --units " + name;
+  }
+  throw Error(file.string() + " (scan " + std::to_string(index + 1) + ")" + text + units);
 }
 
 ScanSequence::ScanSequence(ScanInput input) : input_(std::move(input)) {
@@ -87,6 +102,10 @@ ScanInputCounts ScanSequence::forEach(const Visit& visit, const std::function<vo
                       std::to_string(index + 1) + ")");
         }
         scan.pose = poses_[index].pose;
+      }
+      if (input_.scale != 1.0) {
+        for (Point& point : scan.points) point *= input_.scale;
+        scan.pose.translation() *= input_.scale;
       }
       std::size_t outside = 0;
       for (const Point& point : scan.points) {

@@ -57,6 +57,9 @@ struct ScanInput {
   RangeLimits range{};
   IsolationFilter isolated{};      // off by default; applied after the range limits
   Pose world = Pose::Identity();  // applied after each scan's pose (e.g. turns the data z-up)
+  // m per unit of the files' coordinates and of the pose file's positions (0.001 for
+  // millimetres), applied as each scan is read, before the range limits
+  double scale = 1.0;
 };
 
 struct ScanInputCounts {
