@@ -21,25 +21,11 @@
 #include "mlmap/sim/placement.hpp"
 #include "mlmap/sim/scene.hpp"
 #include "mlmap/sim/simulator.hpp"
+#include "room_scenes.hpp"
 
 using namespace mlmap;
 
 namespace {
-
-// 6 m x 4 m x 2.5 m, empty, two poses (as tests/test_planes_turned.cpp's).
-constexpr const char* kBoxRoomJson = R"({
-  "scan_pattern": {"angular_step_deg": 0.25, "tilt_start_deg": -60, "tilt_end_deg": 60,
-                   "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
-  "poses": [{"x": 2.2, "y": 1.7, "yaw_deg": 20}, {"x": 4.1, "y": 2.4, "yaw_deg": 200}],
-  "surfaces": [
-    {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [6, 4, 0]},
-    {"type": "rectangle", "class": "ceiling", "min": [0, 0, 2.5], "max": [6, 4, 2.5]},
-    {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 4, 2.5]},
-    {"type": "rectangle", "class": "wall", "min": [6, 0, 0], "max": [6, 4, 2.5]},
-    {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [6, 0, 2.5]},
-    {"type": "rectangle", "class": "wall", "min": [0, 4, 0], "max": [6, 4, 2.5]}
-  ]
-})";
 
 const Eigen::Vector3d kNationalGrid(500000.0, 5000000.0, 300.0);
 
@@ -54,7 +40,7 @@ struct SurfaceFinding {
 // and mapped in 5 cm cells; its planes and every point's label; per true surface, the
 // patches on it.
 std::vector<SurfaceFinding> findSurfaces(const Eigen::Vector3d& shift) {
-  sim::Scene scene = sim::parseScene(kBoxRoomJson, "box_room.json");
+  sim::Scene scene = sim::parseScene(test::kBoxRoomJson, "box_room.json");
   sim::transformScene(scene, sim::Placement{0.013, 0.021, 7.0});
   std::vector<sim::SimulatedScan> scans = sim::simulate(scene);
   MLMap map(0.05);
@@ -150,7 +136,7 @@ TEST_CASE("Far from the origin: blocks 300 m up, a cell apart, are read back in 
 // point, and `register` reported 0 inliers and kept the odometry, as if it had tried. Now the
 // sequence runs in a frame near its first scan and gives the same poses as near the origin.
 TEST_CASE("Far from the origin: a sequence registers as near the origin, its poses in the scans' coordinates") {
-  sim::Scene scene = sim::parseScene(kBoxRoomJson, "box_room.json");
+  sim::Scene scene = sim::parseScene(test::kBoxRoomJson, "box_room.json");
   const std::vector<sim::SimulatedScan> scans = sim::simulate(scene);
   REQUIRE(scans.size() == 2);
   Pose start = scans[1].scan.pose;  // the second scan starts 5 cm and 1 deg off

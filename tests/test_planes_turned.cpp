@@ -13,28 +13,12 @@
 #include "mlmap/sim/placement.hpp"
 #include "mlmap/sim/scene.hpp"
 #include "mlmap/sim/simulator.hpp"
+#include "room_scenes.hpp"
 #include "simulated_map.hpp"
 
 using namespace mlmap;
 
 namespace {
-
-// 6 m x 4 m x 2.5 m, empty, two poses; the shipped scenes' beams (0.25 deg), scan lines
-// 1 deg apart (2.5 times the lab's) to stay fast. Turned 7 or 10 deg, the 6 m walls are
-// lost today at this density; with 0.5 deg beams or from one pose they are found.
-constexpr const char* kBoxRoomJson = R"({
-  "scan_pattern": {"angular_step_deg": 0.25, "tilt_start_deg": -60, "tilt_end_deg": 60,
-                   "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
-  "poses": [{"x": 2.2, "y": 1.7, "yaw_deg": 20}, {"x": 4.1, "y": 2.4, "yaw_deg": 200}],
-  "surfaces": [
-    {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [6, 4, 0]},
-    {"type": "rectangle", "class": "ceiling", "min": [0, 0, 2.5], "max": [6, 4, 2.5]},
-    {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 4, 2.5]},
-    {"type": "rectangle", "class": "wall", "min": [6, 0, 0], "max": [6, 4, 2.5]},
-    {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [6, 0, 2.5]},
-    {"type": "rectangle", "class": "wall", "min": [0, 4, 0], "max": [6, 4, 2.5]}
-  ]
-})";
 
 struct WallFinding {
   int patches = 0;             // patches lying on the wall (centroid within 10 cm, normal within 20 deg)
@@ -46,7 +30,7 @@ struct WallFinding {
 // walls do not lie on cell boundaries), simulated, mapped in 5 cm cells; for every wall,
 // the patches that lie on it.
 std::vector<WallFinding> wallsOfTurnedRoom(double yaw_deg) {
-  sim::Scene scene = sim::parseScene(kBoxRoomJson, "box_room.json");
+  sim::Scene scene = sim::parseScene(test::kBoxRoomJson, "box_room.json");
   sim::transformScene(scene, sim::Placement{0.013, 0.021, yaw_deg});
   MLMap map = test::simulatedMap(scene, 0.05);
   const PlaneDetection detection = detectPlanes(map);

@@ -59,8 +59,7 @@ std::vector<HeightRange> patchHeights(std::span<const Point> points, std::span<c
   }
   // Along the patch from its first point: the spans are kept in float, which far from the
   // origin (a national grid's coordinates, 5,000 km) rounds by half a metre.
-  std::vector<Eigen::Vector3d> first_point(slots, Eigen::Vector3d::Zero());
-  std::vector<std::uint8_t> has_first(slots, 0);
+  std::vector<Eigen::Vector3d> first_point(slots, Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   for (std::size_t index = 0; index < points.size(); ++index)
     if (sole[index] != 0 && std::isfinite(points[index].z()))
       base[sole[index]] = std::min(base[sole[index]], static_cast<float>(points[index].z()));
@@ -73,10 +72,7 @@ std::vector<HeightRange> patchHeights(std::span<const Point> points, std::span<c
     if (!(offset >= 0.0 && offset < kMaxHeightBins)) continue;
     const auto n = static_cast<std::size_t>(offset);
     if (n >= bins[slot].size()) bins[slot].resize(n + 1);
-    if (has_first[slot] == 0) {
-      first_point[slot] = points[index];
-      has_first[slot] = 1;
-    }
+    if (std::isnan(first_point[slot].x())) first_point[slot] = points[index];
     const auto u = static_cast<float>(across[slot].dot(points[index] - first_point[slot]));
     bins[slot][n].low = std::min(bins[slot][n].low, u);
     bins[slot][n].high = std::max(bins[slot][n].high, u);
