@@ -102,7 +102,7 @@ def score(mlmap, sim, cell, tag, range_sigma=None):
          "--threads", "2"])
     run([mlmap, "-q", "label", tag + ".planes.mlmap", *scans, "--poses", poses, "-o", tag + ".labels.xyz"])
     labels = np.loadtxt(tag + ".labels.xyz", usecols=3).astype(int)
-    # Label 0: a block no plane matched; -1: no block.
+    # `mlmap label` writes -1 for a point on no plane; ids are the planes JSON's.
     normals = {p["id"]: p["normal"] for p in json.load(open(tag + ".planes.json"))["planes"] if p["id"] > 0}
     return judge(truth, names, labels, normals)
 
