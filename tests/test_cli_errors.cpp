@@ -1,8 +1,11 @@
 // The CLI never gives silent garbage: every error exits 1 with one line in one style
 // ("mlmap: ..."), found before the long work; scans without a pose need --identity.
 #include <doctest/doctest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -86,6 +89,59 @@ TEST_CASE("CLI errors: parse errors, missing files and directories exit 1 with o
   checkOneLineError(runCli("build --identity -o " + room.map + " " + (room.dir / "scan.las").string()),
                     "unknown scan format");
   checkOneLineError(runCli("info " + (room.dir / "none.mlmap").string()), "none.mlmap");
+}
+
+namespace {
+
+// The CLI under `timeout`: a reader that never returns (a device read to its end, a pipe
+// with no writer) fails the test instead of hanging it.
+mlmap::test::CommandResult runCliWithin(int seconds, const std::string& arguments) {
+  const std::string command =
+      "timeout " + std::to_string(seconds) + " " + std::string(MLMAP_CLI_PATH) + " " + arguments + " 2>&1";
+  mlmap::test::CommandResult result;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  char buffer[4096];
+  std::size_t count = 0;
+  while ((count = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, count);
+  const int status = ::pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+}  // namespace
+
+TEST_CASE("CLI errors: a device or a pipe named as an input file is refused at once, not read forever") {
+  // Before: a .pcd linked to /dev/zero, `simulate /dev/zero` and `replay /dev/zero` read
+  // until killed (simulate's memory grew 130 MB a second), a pipe as --poses waited for a
+  // writer, and `export --dashboard-page /dev/zero` wrote an empty page without a word.
+  RoomFiles room;
+  REQUIRE(runCli("-q build --identity --no-octree -o " + room.map + " " + room.scan).exit_code == 0);
+  const fs::path zero_pcd = room.dir / "zero.pcd";
+  fs::create_symlink("/dev/zero", zero_pcd);
+  const fs::path pipe = room.dir / "pipe";
+  REQUIRE(::mkfifo(pipe.c_str(), 0600) == 0);
+  const fs::path pipe_xyz = room.dir / "pipe.xyz";
+  fs::create_symlink(pipe, pipe_xyz);
+  const std::string out = (room.dir / "out").string();
+  checkOneLineError(runCliWithin(20, "-q build --identity -o " + out + ".mlmap " + zero_pcd.string()),
+                    "zero.pcd: not a regular file");
+  checkOneLineError(runCliWithin(20, "-q build --identity -o " + out + ".mlmap " + pipe_xyz.string()),
+                    "pipe.xyz: not a regular file");
+  checkOneLineError(runCliWithin(20, "-q build --poses " + pipe.string() + " -o " + out + ".mlmap " + room.scan),
+                    "pipe: not a regular file");
+  checkOneLineError(runCliWithin(20, "-q build --identity --mount " + pipe.string() + " -o " + out + ".mlmap " +
+                                         room.scan),
+                    "pipe: not a regular file");
+  checkOneLineError(runCliWithin(20, "-q merge " + room.map + " " + room.map + " --transform " + pipe.string() +
+                                         " -o " + out + ".mlmap"),
+                    "pipe: not a regular file");
+  checkOneLineError(runCliWithin(20, "-q simulate /dev/zero -o " + out), "/dev/zero: not a regular file");
+  checkOneLineError(runCliWithin(20, "-q replay /dev/zero -o " + out), "/dev/zero: not a regular file");
+  checkOneLineError(runCliWithin(20, "-q export " + room.map + " --dashboard " + out + " --dashboard-page /dev/zero"),
+                    "/dev/zero: not a regular file");
+  CHECK_FALSE(fs::exists(out));
+  CHECK_FALSE(fs::exists(out + ".mlmap"));
 }
 
 TEST_CASE("CLI errors: numbers parse with a plain message and the paper's parameters are range-checked") {

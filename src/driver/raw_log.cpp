@@ -72,6 +72,11 @@ void RawLog::save(const std::filesystem::path& path) const {
 }
 
 RawLog RawLog::load(const std::filesystem::path& path) {
+  // Read to its end: a device or a pipe never ends (/dev/zero filled the memory).
+  std::error_code error;
+  if (std::filesystem::exists(path, error) && !std::filesystem::is_regular_file(path, error)) {
+    throw Error(path.string() + ": not a regular file");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open");
   std::stringstream buffer;

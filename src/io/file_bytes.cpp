@@ -11,6 +11,9 @@
 namespace mlmap::io {
 
 std::string readWholeFile(const std::filesystem::path& path) {
+  // A device or a pipe has no size to read up to: /dev/zero read as empty (a dashboard page
+  // of nothing was written without a word).
+  requireRegularFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open file");
   in.seekg(0, std::ios::end);

@@ -45,6 +45,8 @@ void requireRegularFile(const std::filesystem::path& path) {
   std::error_code error;
   if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
   if (std::filesystem::is_directory(path, error)) throw Error(path.string() + ": is a directory, not a scan file");
+  // A device or a pipe never ends: a .pcd linked to /dev/zero had its header read forever.
+  if (!std::filesystem::is_regular_file(path, error)) throw Error(path.string() + ": not a regular file");
 }
 
 // Reads the header lines only (up to DATA, at most 64 KB): readPcd parses them properly.

@@ -143,6 +143,11 @@ void writeMountCorrection(const std::filesystem::path& path, const FloorCalibrat
 }
 
 MountCorrection readMountCorrection(const std::filesystem::path& path) {
+  // A pipe would block the parse until its writer closes it.
+  std::error_code error;
+  if (std::filesystem::exists(path, error) && !std::filesystem::is_regular_file(path, error)) {
+    throw Error(path.string() + ": not a regular file");
+  }
   std::ifstream in(path);
   if (!in) throw Error(path.string() + ": cannot open");
   nlohmann::json document;
