@@ -14,8 +14,11 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
-inline CommandResult runCli(const std::string& arguments) {
-  const std::string command = std::string(MLMAP_CLI_PATH) + " " + arguments + " 2>&1";
+// With `timeout_seconds` > 0 the CLI runs under `timeout`: a command that never returns
+// (a reader of a device or a pipe) fails its test with 124 instead of hanging it.
+inline CommandResult runCli(const std::string& arguments, int timeout_seconds = 0) {
+  const std::string deadline = timeout_seconds > 0 ? "timeout " + std::to_string(timeout_seconds) + " " : "";
+  const std::string command = deadline + std::string(MLMAP_CLI_PATH) + " " + arguments + " 2>&1";
   CommandResult result;
   FILE* pipe = ::popen(command.c_str(), "r");
   REQUIRE(pipe != nullptr);
