@@ -275,6 +275,26 @@ void rawLogSeed(const Corpus& corpus) {
 
 }  // namespace
 
+// The shipped scenes (boxes, a cylinder, includes and an opening; run from the repository's
+// root, as scripts/fuzz.sh does) and a flight of stairs.
+void sceneSeeds(const Corpus& corpus) {
+  for (const char* name : {"lab", "corridor", "building_lab"}) {
+    const fs::path path = fs::path("maps") / (std::string(name) + ".json");
+    if (fs::exists(path)) corpus.add("scene", name, readAll(path));
+  }
+  corpus.add("scene", "stairs", R"({"name": "stairwell",
+ "scan_pattern": {"field_of_view_deg": 270, "angular_step_deg": 0.25, "tilt_start_deg": -30, "tilt_end_deg": 40,
+                  "tilt_step_deg": 0.5, "min_range": 0.023, "max_range": 30, "range_sigma": 0.01, "mount_height": 1.2, "seed": 3},
+ "odometry": {"translation_noise_per_m": 0.0, "yaw_noise_per_rad": 0.0, "yaw_noise_per_m": 0.0, "seed": 7},
+ "poses": [{"x": 3.0, "y": 2.0, "yaw_deg": 4}],
+ "surfaces": [
+  {"type": "rectangle", "name": "floor", "class": "floor", "min": [0, 0, 0], "max": [14, 4.5, 0]},
+  {"type": "rectangle", "name": "wall", "class": "wall", "min": [0, 0, 0], "max": [0, 4.5, 5.0], "facing": "+x"},
+  {"type": "stairs", "name": "flight", "start": [5.0, 0.6], "yaw_deg": 4, "width": 3.0, "steps": 13,
+   "riser": 0.14, "tread": 0.30, "top_depth": 1.5}]}
+)");
+}
+
 int main(int argc, char** argv) {
   if (argc != 2) {
     std::fprintf(stderr, "usage: %s CORPUS_DIR\n", argv[0]);
@@ -285,6 +305,7 @@ int main(int argc, char** argv) {
   scipSeeds(corpus);
   ptuSeeds(corpus);
   rawLogSeed(corpus);
+  sceneSeeds(corpus);
   corpus.clearScratch();
   return 0;
 }
