@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "mlmap/error.hpp"
+#include "mlmap/io/regular_file.hpp"
 
 namespace mlmap::driver {
 namespace {
@@ -78,10 +79,7 @@ MountConfig parseMountConfig(std::string_view json_text, const std::string& sour
 
 MountConfig loadMountConfig(const std::filesystem::path& path) {
   // Read to its end: a device or a pipe never ends.
-  std::error_code error;
-  if (std::filesystem::exists(path, error) && !std::filesystem::is_regular_file(path, error)) {
-    throw Error(path.string() + ": not a regular file");
-  }
+  io::refuseNonRegularFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open");
   std::stringstream text;

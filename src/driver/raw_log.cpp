@@ -8,6 +8,7 @@
 
 #include "mlmap/error.hpp"
 #include "mlmap/io/atomic_file.hpp"
+#include "mlmap/io/regular_file.hpp"
 
 namespace mlmap::driver {
 namespace {
@@ -73,10 +74,7 @@ void RawLog::save(const std::filesystem::path& path) const {
 
 RawLog RawLog::load(const std::filesystem::path& path) {
   // Read to its end: a device or a pipe never ends (/dev/zero filled the memory).
-  std::error_code error;
-  if (std::filesystem::exists(path, error) && !std::filesystem::is_regular_file(path, error)) {
-    throw Error(path.string() + ": not a regular file");
-  }
+  io::refuseNonRegularFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open");
   std::stringstream buffer;

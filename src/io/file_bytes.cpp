@@ -50,14 +50,6 @@ MappedFile::~MappedFile() {
   if (data_ != nullptr) ::munmap(const_cast<char*>(data_), size_);
 }
 
-void requireRegularFile(const std::filesystem::path& path) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
-  if (!std::filesystem::is_regular_file(path, error)) {
-    throw Error(path.string() + ": not a regular file");
-  }
-}
-
 std::ifstream openForReading(const std::filesystem::path& path) {
   requireRegularFile(path);
   std::ifstream in(path, std::ios::binary);

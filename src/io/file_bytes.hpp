@@ -14,13 +14,12 @@
 #include <string_view>
 #include <utility>
 
+#include "mlmap/io/regular_file.hpp"
+
 namespace mlmap::io {
 
 // The file's bytes; mlmap::Error "path: cannot open file" and the like.
 std::string readWholeFile(const std::filesystem::path& path);
-
-// Throws mlmap::Error "path: no such file" or "path: not a regular file".
-void requireRegularFile(const std::filesystem::path& path);
 
 // requireRegularFile, then a binary stream; "path: cannot open for reading".
 std::ifstream openForReading(const std::filesystem::path& path);

@@ -9,6 +9,7 @@
 #include "mlmap/error.hpp"
 #include "mlmap/io/pcd.hpp"
 #include "mlmap/io/ply.hpp"
+#include "mlmap/io/regular_file.hpp"
 #include "mlmap/io/scan_graph.hpp"
 #include "mlmap/io/threedtk.hpp"
 #include "mlmap/io/xyz.hpp"
@@ -41,12 +42,11 @@ std::vector<Scan> single(Scan scan) {
   return scans;
 }
 
-void requireRegularFile(const std::filesystem::path& path) {
+// A device or a pipe never ends: a .pcd linked to /dev/zero had its header read forever.
+void requireScanFile(const std::filesystem::path& path) {
   std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
   if (std::filesystem::is_directory(path, error)) throw Error(path.string() + ": is a directory, not a scan file");
-  // A device or a pipe never ends: a .pcd linked to /dev/zero had its header read forever.
-  if (!std::filesystem::is_regular_file(path, error)) throw Error(path.string() + ": not a regular file");
+  requireRegularFile(path);
 }
 
 // Reads the header lines only (up to DATA, at most 64 KB): readPcd parses them properly.
@@ -66,7 +66,7 @@ bool pcdHeaderHasViewpoint(const std::filesystem::path& path) {
 
 ScanFileKind scanFileKind(const std::filesystem::path& path) {
   const Format format = formatOf(path);
-  requireRegularFile(path);
+  requireScanFile(path);
   return ScanFileKind{.single_scan = format != Format::Graph,
                       .carries_pose = format == Format::ThreeDtk || format == Format::Graph ||
                                       (format == Format::Pcd && pcdHeaderHasViewpoint(path))};
@@ -74,7 +74,7 @@ ScanFileKind scanFileKind(const std::filesystem::path& path) {
 
 std::vector<Scan> readScans(const std::filesystem::path& path) {
   const Format format = formatOf(path);
-  requireRegularFile(path);
+  requireScanFile(path);
   switch (format) {
     case Format::Xyz:
       return single(readXyz(path));

@@ -22,10 +22,7 @@ constexpr double kMinQuaternionNorm = 1e-6;
 }  // namespace
 
 std::vector<StampedPose> readTumPoses(const std::filesystem::path& path) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
-  // Before opening it: opening a pipe waits for its writer.
-  if (!std::filesystem::is_regular_file(path, error)) throw Error(path.string() + ": not a regular file");
+  requireRegularFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open for reading");
   TextLines lines(in, path.string());

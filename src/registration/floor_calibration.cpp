@@ -11,6 +11,7 @@
 
 #include "mlmap/error.hpp"
 #include "mlmap/io/atomic_file.hpp"
+#include "mlmap/io/regular_file.hpp"
 
 namespace mlmap::registration {
 namespace {
@@ -144,10 +145,7 @@ void writeMountCorrection(const std::filesystem::path& path, const FloorCalibrat
 
 MountCorrection readMountCorrection(const std::filesystem::path& path) {
   // A pipe would block the parse until its writer closes it.
-  std::error_code error;
-  if (std::filesystem::exists(path, error) && !std::filesystem::is_regular_file(path, error)) {
-    throw Error(path.string() + ": not a regular file");
-  }
+  io::refuseNonRegularFile(path);
   std::ifstream in(path);
   if (!in) throw Error(path.string() + ": cannot open");
   nlohmann::json document;

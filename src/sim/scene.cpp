@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "mlmap/error.hpp"
+#include "mlmap/io/regular_file.hpp"
 #include "scene_loader.hpp"
 #include "scene_surfaces.hpp"
 
@@ -226,10 +227,7 @@ nlohmann::json parseSceneDocument(std::string_view json_text, const std::string&
 
 nlohmann::json readSceneDocument(const std::filesystem::path& path) {
   // Read to its end: a device or a pipe never ends (/dev/zero filled the memory).
-  std::error_code error;
-  if (std::filesystem::exists(path, error) && !std::filesystem::is_regular_file(path, error)) {
-    throw Error(path.string() + ": not a regular file");
-  }
+  io::refuseNonRegularFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open scene file");
   std::ostringstream text;
