@@ -92,8 +92,8 @@ def judge(truth, names, labels, normals):
     return len(steps), found, ramps
 
 
-def score(mlmap, sim, cell, tag, range_sigma=None):
-    scans, truth, names = truth_of(sim)
+def score(mlmap, sim, labelled, cell, tag, range_sigma=None):
+    scans, truth, names = labelled
     poses = os.path.join(sim, "poses_true.txt")
     noise = ["--range-sigma", f"{range_sigma:g}"] if range_sigma else []
     run([mlmap, "-q", "build", *scans, "--poses", poses, "--no-octree", "--cell-size", str(cell), "-o", tag + ".mlmap"] +
@@ -107,10 +107,10 @@ def score(mlmap, sim, cell, tag, range_sigma=None):
     return judge(truth, names, labels, normals)
 
 
-def score_cgal(peers, sim, noise, tag):
+def score_cgal(peers, sim, labelled, noise, tag):
     """CGAL's efficient RANSAC on the same world points, told the simulated noise (ε = 3σ, as
     bench/peer_scene.py), at most 60 planes of at least 200 points."""
-    _, truth, names = truth_of(sim)
+    _, truth, names = labelled
     world = os.path.join(sim, "all_world.xyz")  # the scans' points in their order, world frame
     done = subprocess.run([os.path.join(peers, "cgal_ransac"), world, "--eps", f"{3 * noise:g}", "--angle", "20",
                            "--min-support", "200", "--max-planes", "60", "--labels", tag + ".cgal.labels"],
@@ -159,10 +159,11 @@ def main():
                     json.dump(scene(height, yaw, noise), f, indent=1)
                 sim = os.path.join(folder, "sim")
                 run([os.path.join(a.build, "mlmap"), "-q", "simulate", scene_file, "-o", sim])
+                labelled = truth_of(sim)  # read once: every build, cell size and CGAL score the same points
                 for b in builds:
                     for cell in [float(c) for c in a.cells.split(",")]:
                         tag = os.path.join(folder, f"{os.path.basename(os.path.normpath(os.path.dirname(b + '/')))}-{cell}")
-                        seen, found, ramps = score(os.path.join(b, "mlmap"), sim, cell, tag,
+                        seen, found, ramps = score(os.path.join(b, "mlmap"), sim, labelled, cell, tag,
                                                    noise if a.known_noise else None)
                         totals[b][0] += len(found)
                         totals[b][1] += seen
@@ -170,7 +171,7 @@ def main():
                         print(f"| {b} | {noise:g} | {height} | {yaw:g} | {cell} | {len(found)} of {seen} | {ramps} | "
                               f"{seen - len(found)} |", flush=True)
                 if a.peers:
-                    seen, found, ramps = score_cgal(a.peers, sim, noise, os.path.join(folder, "cgal"))
+                    seen, found, ramps = score_cgal(a.peers, sim, labelled, noise, os.path.join(folder, "cgal"))
                     totals["CGAL"][0] += len(found)
                     totals["CGAL"][1] += seen
                     totals["CGAL"][2] += ramps
