@@ -55,11 +55,19 @@ void Detector::growIntoSparse(std::size_t first) {
 }
 
 // After the sparse growth: the sparse surfaces no patch reached (sparse_search.hpp),
-// each a patch of its own; the coplanar merge joins those that touch a patch.
+// each a patch of its own; the coplanar merge joins those that touch a patch. Their
+// blocks hold a point or two each, as noisy as the scanner's range, so their tolerance is
+// the build's σ_m (max_epsilon) where that is wider than ε: ε follows the map's σ, read
+// from dense blocks (their points averaged) on floors seen at grazing angles, which lie
+// far thinner than a wall seen head on. Simulated halls with 3 cm of range noise: σ read
+// 1.4 cm, ε 5 cm, and the far end wall 12-14 m off (2,300 single-point blocks whose
+// neighbourhoods lie 2.5-3 cm thick) was on no patch; with it the halls found it
+// (bench/planes_sweep.py, halls 1-2 and the fresh halls 5-8 at 5 cm cells, 9 of 9
+// variants that lacked it), and no variant lost a surface.
 void Detector::findSparse() {
   if (config_.sparse_gap <= 0.0) return;
   const SparseSearch search{.max_gap = config_.sparse_gap,
-                            .epsilon = config_.epsilon,
+                            .epsilon = std::max(config_.epsilon, config_.max_epsilon),
                             .max_tilt_rad = radians(ClassifyConfig{}.horizontal_deg),
                             .ladder_gap = config_.ladder_gap,
                             .min_blocks = static_cast<std::size_t>(std::max(config_.min_patch_blocks, 1)),
