@@ -75,6 +75,7 @@ class MLMap {
     std::uint16_t count = 0;
     std::uint16_t capacity = 0;
   };
+  static constexpr std::size_t kMaxBlocksPerCell = UINT16_MAX;  // Cell::count's range
 
   std::size_t findOrCreateCell(CellIndex cell);
   void reserveCell(Cell& cell, std::size_t capacity);
