@@ -131,6 +131,26 @@ std::map<std::int32_t, std::int32_t> surfaceOfPatches(const std::vector<std::int
   return surface_of;
 }
 
+// The floor's points (true plane 0) of a scanned scene, refined with its beams, and how many
+// of them went to patches whose surface (surfaceOfPatches) is at least `first_surface`.
+struct FloorOn {
+  std::size_t floor = 0;
+  std::size_t on_others = 0;
+};
+
+FloorOn floorPointsOn(const Scanned& scanned, std::int32_t first_surface) {
+  std::vector<std::int32_t> labels = scanned.blockLabels();
+  refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, scanned.options(), scanned.beams());
+  std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, scanned.truth);
+  FloorOn counted;
+  for (std::size_t k = 0; k < scanned.points.size(); ++k) {
+    if (scanned.truth[k] != 0) continue;
+    ++counted.floor;
+    counted.on_others += labels[k] > 0 && surface_of[labels[k]] >= first_surface ? 1 : 0;
+  }
+  return counted;
+}
+
 }  // namespace
 
 TEST_CASE("Point labels: floor points in the wall's corner blocks leave the wall for the floor") {
@@ -470,15 +490,8 @@ TEST_CASE("Point labels: floor points at the foot of a turned cabinet, whose fac
                    R"({"type": "box", "class": "other", "min": [0, 1.0, 0], "max": [0.5, 3.0, 1.8], "omit": ["bottom", "x-"]},
       {"type": "box", "class": "other", "min": [4.0, 1.0, 0], "max": [4.6, 1.5, 0.5], "omit": ["bottom"]})"),
       "turned_cabinet.json", 2.0);
-  std::vector<std::int32_t> labels = scanned.blockLabels();
-  refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, scanned.options(), scanned.beams());
-  std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, scanned.truth);
-  std::size_t floor = 0, floor_on_faces = 0;
-  for (std::size_t k = 0; k < scanned.points.size(); ++k) {
-    if (scanned.truth[k] != 0) continue;
-    ++floor;
-    floor_on_faces += labels[k] > 0 && surface_of[labels[k]] > 5 ? 1 : 0;
-  }
+  const FloorOn counted = floorPointsOn(scanned, 6);  // the cabinets' faces
+  const std::size_t floor = counted.floor, floor_on_faces = counted.on_others;
   MESSAGE(floor << " floor points, " << floor_on_faces << " on the cabinet's patches");
   REQUIRE(floor > 10000);
   CHECK(floor_on_faces == 0);
@@ -510,18 +523,10 @@ TEST_CASE("Point labels: floor points at a far wall's foot go to the floor, whos
   for (const double turn : {5.0, 22.5}) {
     CAPTURE(turn);
     const Scanned scanned(hall, "hall_" + std::to_string(static_cast<int>(turn)) + ".json", turn);
-    std::vector<std::int32_t> labels = scanned.blockLabels();
-    refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, scanned.options(), scanned.beams());
-    std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, scanned.truth);
-    std::size_t floor = 0, floor_on_walls = 0;
-    for (std::size_t k = 0; k < scanned.points.size(); ++k) {
-      if (scanned.truth[k] != 0) continue;
-      ++floor;
-      floor_on_walls += labels[k] > 0 && surface_of[labels[k]] >= 2 ? 1 : 0;
-    }
-    MESSAGE(turn << " deg: " << floor << " floor points, " << floor_on_walls << " on the walls' patches");
-    REQUIRE(floor > 10000);
-    floor_on_walls_all += floor_on_walls;
+    const FloorOn counted = floorPointsOn(scanned, 2);  // the walls
+    MESSAGE(turn << " deg: " << counted.floor << " floor points, " << counted.on_others << " on the walls' patches");
+    REQUIRE(counted.floor > 10000);
+    floor_on_walls_all += counted.on_others;
   }
   CHECK(floor_on_walls_all <= 60);
 }
