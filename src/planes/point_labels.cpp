@@ -166,6 +166,12 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     }
     return false;
   };
+  // How many cells round a place at height z the level patches' blocks are looked for: two
+  // by a vertical block's end or a face's foot, else one. The candidates' search (gather)
+  // and the test that the beam meets a level patch where it is (onPatch) look as far.
+  const auto levelReach = [&](const CellIndex& cell, double z) {
+    return byVerticalEnd(map, cell, z, reach) || byFaceFoot(cell, z) ? kNearLevel : kNear;
+  };
   // The patches each point lies on (within tolerance of their refitted planes), among its
   // collecting block's and those of the blocks round it that reach its height.
   // `tail` (optional): the patches whose planes lie beyond their tolerance but within
@@ -204,7 +210,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     if (slot_of_point[index] != 0) consider(slot_of_point[index]);
     const auto cell = map.findCellOf(p.x(), p.y());
     if (cell && p.allFinite()) {
-      const std::int32_t near = byVerticalEnd(map, cell, p.z(), reach) || byFaceFoot(*cell, p.z()) ? kNearLevel : kNear;
+      const std::int32_t near = levelReach(*cell, p.z());
       const auto visitRing = [&](std::int32_t from, std::int32_t to) {
         for (std::int32_t di = -to; di <= to; ++di) {
           for (std::int32_t dj = -to; dj <= to; ++dj) {
@@ -303,21 +309,17 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   if (heights_wanted) heights = patchHeights(points, sole, fitted, 2.0 * reach);
   // Whether the beam meets a candidate's plane where its patch is: within the height its
   // own points reach and near one of its blocks (within the plane's tolerance of the
-  // block's extent, in the cells round that place). A level patch's blocks are looked for
-  // two cells round where a vertical block ends there or a face took the level strip there
-  // (byFaceFoot: gather looks as far for the candidates), else one: along a far wall's
-  // foot a sparse floor's blocks lie two cells off, and its points stayed the wall's
-  // (planes_sweep.py: tuning scenes 3 of 240 variants better, held out 3 of 60, none worse).
+  // block's extent, in the cells round that place). A level patch's as far as levelReach:
+  // along a far wall's foot a sparse floor's blocks lie two cells off, and with one cell its
+  // points stayed the wall's (planes_sweep.py: tuning scenes 3 of 240 variants better, held
+  // out 3 of 60, none worse).
   const auto onPatch = [&](const Point& p, const Eigen::Vector3d& beam, const Candidate& c) {
     const Point q = p + c.meets * beam;
     const PointPlane& plane = fitted[c.slot];
     if (!(q.z() >= heights[c.slot].low && q.z() <= heights[c.slot].high)) return false;
     const auto at = map.findCellOf(q.x(), q.y());
     if (!at || !q.allFinite()) return false;
-    const std::int32_t near =
-        std::abs(plane.normal.z()) >= kLevelCosine && (byVerticalEnd(map, at, q.z(), reach) || byFaceFoot(*at, q.z()))
-            ? kNearLevel
-            : kNear;
+    const std::int32_t near = std::abs(plane.normal.z()) >= kLevelCosine ? levelReach(*at, q.z()) : kNear;
     for (std::int32_t di = -near; di <= near; ++di)
       for (std::int32_t dj = -near; dj <= near; ++dj)
         for (const Block& block : map.blocks(CellIndex{at->i + di, at->j + dj}))
