@@ -67,7 +67,8 @@ int runLabel(const LabelArguments& arguments, bool quiet) {
   if (!arguments.block_labels)
     refinePointLabels(map.blocks(), map.planes()->planes, labelled.points, labelled.labels,
                       PointLabelRefinement{.noise = labelNoiseCap(*map.planes(), !arguments.input.poses.empty()),
-                                           .band = map.planes()->config.epsilon + 0.5 * map.blocks().cellSize()},
+                                           .band = map.planes()->config.epsilon + 0.5 * map.blocks().cellSize(),
+                                           .level_gap = map.planes()->config.sparse_gap},
                       // Without a pose file a scan's frame may be the world's, not its
                       // scanner's: then where its beams started is unknown.
                       arguments.input.poses.empty() ? BeamOrigins{} : BeamOrigins{scanner_positions, scan_of_point});

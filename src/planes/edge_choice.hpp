@@ -35,6 +35,8 @@ constexpr double kMinIncidenceCosine = 0.05;
 
 // |n_z| of a level patch: within the detector's θ (15°).
 constexpr double kLevelCosine = 0.966;
+// |n_z| of a plumb patch (a wall, a box side, a riser): within θ of vertical.
+constexpr double kPlumbSine = 0.259;
 
 // Planes closer in direction than this are layers of one surface (or parallel ones),
 // not two surfaces meeting at an edge: the detector's κ (25°).

@@ -9,41 +9,17 @@
 
 #include "edge_choice.hpp"
 #include "label_fits.hpp"
+#include "label_candidates.hpp"
 #include "patch_sides.hpp"
 #include "mlmap/error.hpp"
 #include "pca_sums.hpp"
 
 namespace mlmap {
 
-// How many cells round a point its candidate patches' blocks are looked for: one, and two
-// for level patches (kLevelCosine). Where a wall or a cabinet stands on the floor, the column holding its
-// foot holds the floor's strip there too, in the vertical block (section IV joins them),
-// and a face on a cell boundary fills both columns beside it: the floor's nearest own
-// block can lie two cells from a floor point at the foot, and that point went to the face
-// (the simulated lab at 5 cm: 9 floor points on 8 faces standing on it, each face then
-// "touching" the floor in issue 19's held-out measure). So the second ring is looked at
-// only for a point by the foot or the top of a vertical block in its own cell, and only for
-// level patches: with every patch looked for two cells away, the neighbouring tilted
-// blocks of plane_seg's steps at 10 cm took each other's edges.
-constexpr std::int32_t kNear = 1;
-constexpr std::int32_t kNearLevel = 2;
-// How far past a surface's tolerance (3σ) its noise tail is looked for (behindEdge): 6σ,
-// beyond which a normal tail holds one point in 500 million.
-constexpr double kTailTolerances = 2.0;
 // surfaceTail's reach, 4 σ where the tolerance is 3 σ, and the surface's size against the
 // patch's (edge_choice.hpp says what they were measured on).
 constexpr double kSurfaceTailTolerances = 4.0 / 3.0;
 constexpr double kSurfaceTailRatio = 50.0;
-
-// Whether the column of cell `at` holds a vertical block whose foot or top lies within
-// `reach` of height z: where a level surface's strip can hide in that block.
-bool byVerticalEnd(const MLMap& map, std::optional<CellIndex> at, double z, double reach) {
-  if (!at) return false;
-  for (const Block& block : map.blocks(*at))
-    if (block.isVertical() && (std::abs(z - block.bottom()) <= reach || std::abs(z - block.height) <= reach))
-      return true;
-  return false;
-}
 
 std::vector<std::int32_t> labelPoints(const MLMap& map, const Scan& scan) {
   std::vector<std::int32_t> labels(scan.size(), -1);
@@ -94,10 +70,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     if (plane.id > 0) ids.push_back(plane.id);
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  const auto slotOf = [&ids](std::int32_t id) -> std::uint32_t {
-    const auto found = std::lower_bound(ids.begin(), ids.end(), id);
-    return found != ids.end() && *found == id ? static_cast<std::uint32_t>(found - ids.begin()) + 1 : 0;
-  };
+  const auto slotOf = [&ids](std::int32_t id) { return slotOfId(ids, id); };
   const std::size_t slots = ids.size() + 1;
   std::vector<PointPlane> fitted(slots);
   std::vector<const Plane*> plane_of_slot(slots, nullptr);  // the first plane of each id
@@ -152,92 +125,14 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   std::vector<double> along_tolerance =
       beams.origin_of_point.empty() ? std::vector<double>(slots, std::numeric_limits<double>::infinity())
                                     : alongTolerances(points, slot_of_point, fitted, beamOf, options.sigmas);
-  // Whether the cell holds, near height z, a level block that the detector gave to a patch
-  // that is not level: a face took the floor's strip in its column, where the floor's own
-  // blocks can lie two cells off (the simulated lab turned 2-10°: a floor point at a
-  // cabinet's foot had the face as its only candidate, and the face then touched the floor
-  // in issue 19's held-out measure). There, as by a vertical block's end, the level
-  // patches' blocks are looked for two cells round.
-  const auto byFaceFoot = [&](const CellIndex& cell, double z) {
-    for (const Block& block : map.blocks(cell)) {
-      if (block.plane <= 0 || block.isVertical() || z > block.height + reach || z < block.bottom() - reach) continue;
-      const std::uint32_t slot = slotOf(block.plane);
-      if (slot != 0 && std::abs(fitted[slot].normal.z()) < kLevelCosine) return true;
-    }
-    return false;
+  LabelCandidates candidates_of(map, points, slot_of_point, ids, fitted, along_tolerance, options.level_gap);
+  const auto gather = [&candidates_of](std::size_t index, const Eigen::Vector3d& beam,
+                                       std::array<Candidate, kMaxCandidates>& out,
+                                       std::array<Candidate, kMaxCandidates>* tail = nullptr,
+                                       std::size_t* tail_found = nullptr) {
+    return candidates_of.gather(index, beam, out, tail, tail_found);
   };
-  // How many cells round a place at height z the level patches' blocks are looked for: two
-  // by a vertical block's end or a face's foot, else one. The candidates' search (gather)
-  // and the test that the beam meets a level patch where it is (onPatch) look as far.
-  const auto levelReach = [&](const CellIndex& cell, double z) {
-    return byVerticalEnd(map, cell, z, reach) || byFaceFoot(cell, z) ? kNearLevel : kNear;
-  };
-  // The patches each point lies on (within tolerance of their refitted planes), among its
-  // collecting block's and those of the blocks round it that reach its height.
-  // `tail` (optional): the patches whose planes lie beyond their tolerance but within
-  // kTailTolerances of it, and `tail_found` their count.
-  const auto gather = [&](std::size_t index, const Eigen::Vector3d& beam, std::array<Candidate, kMaxCandidates>& out,
-                          std::array<Candidate, kMaxCandidates>* tail = nullptr, std::size_t* tail_found = nullptr) {
-    const Point& p = points[index];
-    std::size_t found = 0;
-    if (tail_found != nullptr) *tail_found = 0;
-    if (!p.allFinite()) return found;
-    const auto consider = [&](std::uint32_t slot) {
-      const PointPlane& plane = fitted[slot];
-      const double signed_distance = plane.normal.dot(p) + plane.offset;
-      const double along = plane.normal.dot(beam);
-      // Where the beam meets the plane, from the measured point along it (m).
-      const double meets = std::abs(along) >= kMinIncidenceCosine ? -signed_distance / along : 0.0;
-      const double rank = beam.isZero() ? std::abs(signed_distance) / plane.tolerance
-                                        : std::abs(signed_distance) / std::max(kMinIncidenceCosine, std::abs(along));
-      if (std::abs(signed_distance) > plane.tolerance) {
-        // Across the plane a tail point lies no farther than along its beam.
-        const double tail_reach =
-            std::isfinite(along_tolerance[slot]) ? std::max(plane.tolerance, along_tolerance[slot]) : plane.tolerance;
-        if (tail == nullptr || *tail_found == kMaxCandidates ||
-            std::abs(signed_distance) > kTailTolerances * tail_reach)
-          return;
-        for (std::size_t c = 0; c < *tail_found; ++c)
-          if ((*tail)[c].slot == slot) return;
-        (*tail)[(*tail_found)++] = Candidate{slot, rank, meets};
-        return;
-      }
-      if (found == kMaxCandidates) return;
-      for (std::size_t c = 0; c < found; ++c)
-        if (out[c].slot == slot) return;
-      out[found++] = Candidate{slot, rank, meets};
-    };
-    if (slot_of_point[index] != 0) consider(slot_of_point[index]);
-    const auto cell = map.findCellOf(p.x(), p.y());
-    if (cell && p.allFinite()) {
-      const std::int32_t near = levelReach(*cell, p.z());
-      const auto visitRing = [&](std::int32_t from, std::int32_t to) {
-        for (std::int32_t di = -to; di <= to; ++di) {
-          for (std::int32_t dj = -to; dj <= to; ++dj) {
-            const std::int32_t ring = std::max(std::abs(di), std::abs(dj));
-            if (ring < from) continue;
-            const bool outer = ring > kNear;
-            for (const Block& block : map.blocks(CellIndex{cell->i + di, cell->j + dj})) {
-              if (block.plane <= 0 || p.z() > block.height + reach || p.z() < block.bottom() - reach) continue;
-              const std::uint32_t slot = slotOf(block.plane);
-              if (slot != 0 && (!outer || std::abs(fitted[slot].normal.z()) >= kLevelCosine)) consider(slot);
-            }
-          }
-        }
-      };
-      visitRing(0, near);
-      // A point with faces alone as candidates is at a face's foot as surely as one whose
-      // cell holds the face's block (byFaceFoot): level patches two cells round too (the
-      // floor's points on box sides and risers of make_scene.py's rooms at 0.05 m: their
-      // walls/floor/ceiling/table F1 0.970 -> 0.978, seeds 2-3; real scans the same).
-      if (near == kNear && found > 0) {
-        bool level = false;
-        for (std::size_t c = 0; c < found; ++c) level |= std::abs(fitted[out[c].slot].normal.z()) >= kLevelCosine;
-        if (!level) visitRing(kNear + 1, kNearLevel);
-      }
-    }
-    return found;
-  };
+  const auto levelReach = [&candidates_of](const CellIndex& cell, double z) { return candidates_of.levelReach(cell, z); };
   // A third fit without the points at an edge: those within tolerance of the plane of a
   // patch round them that meets theirs (not parallel). The blocks along an edge collect
   // both surfaces' points, and the two fits above keep those within a band (then the
@@ -251,6 +146,9 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   // heavier tails (PCL's, 3DTK's and OctoMap's walls lost 1-2 % of their points).
   // With beams, the same pass finds the one patch each point lies on, where it lies on one
   // (`sole`, for patchHeights below): the planes move by millimetres in the third fit.
+  // Where the level patches' blocks lie, for the search past two cells at a face's foot:
+  // built before the third fit, which first asks, on the second's planes.
+  candidates_of.coverLevelPatches();
   const bool heights_wanted = !beams.origin_of_point.empty();
   std::vector<std::uint32_t> sole(heights_wanted ? points.size() : 0, 0);
   {
