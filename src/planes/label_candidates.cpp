@@ -139,26 +139,32 @@ std::size_t LabelCandidates::gather(std::size_t index, const Eigen::Vector3d& be
     // out in a hall (planes_sweep.py's hall-2) had the floor's nearest block three cells off,
     // the next point of its own scan line, and went to the face. Plumb faces only: fr079's
     // steps at 10 cm, patches leaning 30° over the flight, gave band points to a small level
-    // patch 0.5 m off. At a foot only (the face's blocks rise above the point in its column or
-    // those round it): at a face's top a desk's top 0.5 m away took the top strip of a
-    // cabinet's face beside it (office-4 at 2 cm of noise).
+    // patch 0.5 m off. At a foot only (in the point's column and those round it the face's
+    // blocks rise above the point, none lies below it): at a face's top a desk's top 0.5 m
+    // away took the top strip of a cabinet's face beside it (office-4 at 2 cm of noise), and
+    // halfway up a chair's back the strip at the height of the desk behind it (office-23).
     const auto facesOnly = [&] {
       for (std::size_t c = 0; c < found; ++c)
         if (std::abs(fitted_[out[c].slot].normal.z()) > kPlumbSine) return false;
       return found > 0;
     };
-    const auto faceRises = [&] {
+    const auto atFaceFoot = [&] {
+      bool above = false;
       for (std::int32_t di = -1; di <= 1; ++di)
         for (std::int32_t dj = -1; dj <= 1; ++dj)
           for (const Block& block : map_.blocks(CellIndex{cell->i + di, cell->j + dj})) {
-            if (block.plane <= 0 || block.bottom() <= p.z() + reach_) continue;
+            const bool up = block.bottom() > p.z() + reach_, down = block.height < p.z() - reach_;
+            if (block.plane <= 0 || !(up || down)) continue;
             const std::uint32_t slot = slotOf(block.plane);
-            for (std::size_t c = 0; c < found; ++c)
-              if (out[c].slot == slot) return true;
+            for (std::size_t c = 0; c < found; ++c) {
+              if (out[c].slot != slot) continue;
+              if (down) return false;
+              above = true;
+            }
           }
-      return false;
+      return above;
     };
-    if (reached == kNearLevel && level_cover_ && facesOnly() && faceRises()) {
+    if (reached == kNearLevel && level_cover_ && facesOnly() && atFaceFoot()) {
       level_cover_->forEachNear(*cell, [&](std::uint32_t slot) {
         if (std::abs(fitted_[slot].normal.z()) >= kLevelCosine) consider(slot);
       });
