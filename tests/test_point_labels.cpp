@@ -20,10 +20,15 @@
 #include "mlmap/sim/simulator.hpp"
 #include "helpers.hpp"
 #include "room_scenes.hpp"
+#include "scanned_scene.hpp"
 
 using namespace mlmap;
 
 namespace {
+
+using test::Scanned;
+using test::boxRoomScene;
+using test::surfaceOfPatches;
 
 // A floor (z = 0) meeting a wall at x = 1.98, i.e. inside the cells 1.95–2.00 m at
 // 5 cm: those cells' floor points join the wall's vertical blocks. The scan holds
@@ -55,64 +60,6 @@ struct Corner {
   }
 };
 
-// A simulated scene's points in the world frame, each with its true plane and the
-// scanner it was seen from, mapped at 5 cm, and the planes detected on that map.
-struct Scanned {
-  std::vector<Point> points;
-  std::vector<std::int32_t> truth;
-  std::vector<Point> scanners;
-  std::vector<std::uint32_t> scanner_of_point;
-  MLMap map{0.05};
-  PlaneDetection detection;
-
-  // `turn_deg`: the whole scene turned about z (the map's grid stays).
-  Scanned(const std::string& scene_json, const std::string& name, double turn_deg = 0.0) {
-    const Eigen::Matrix3d turn = Eigen::AngleAxisd(turn_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    for (const sim::SimulatedScan& simulated : sim::simulate(sim::parseScene(scene_json, name))) {
-      const Scan& scan = simulated.scan;
-      for (std::size_t k = 0; k < scan.size(); ++k) {
-        points.push_back(turn * scan.worldPoint(k));
-        truth.push_back(scan.labels[k]);
-        scanner_of_point.push_back(static_cast<std::uint32_t>(scanners.size()));
-        map.insert(points.back(), scan.variance(k));
-      }
-      scanners.push_back(turn * scan.pose.translation());
-    }
-    detection = detectPlanes(map);
-  }
-
-  PointLabelRefinement options() const {
-    return PointLabelRefinement{.noise = detection.config.noise,
-                                .band = detection.config.epsilon + 0.5 * map.cellSize(),
-                                .level_gap = detection.config.sparse_gap};
-  }
-  BeamOrigins beams() const { return BeamOrigins{scanners, scanner_of_point}; }
-  // Each point's collecting block's label (labelPoints).
-  std::vector<std::int32_t> blockLabels() const {
-    Scan all;
-    all.points = points;
-    return labelPoints(map, all);
-  }
-};
-
-// A 6 x 5 x 2.8 m room (its floor, ceiling and walls are true planes 0-5) with the given
-// poses and furniture, scanned with 1 cm of range noise at 0.5 deg beams and 1 deg lines.
-std::string boxRoomScene(const std::string& poses, const std::string& furniture) {
-  return R"({
-    "scan_pattern": {"angular_step_deg": 0.5, "tilt_start_deg": -50, "tilt_end_deg": 50,
-                     "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
-    "poses": [)" + poses + R"(],
-    "surfaces": [
-      {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [6, 5, 0]},
-      {"type": "rectangle", "class": "ceiling", "min": [0, 0, 2.8], "max": [6, 5, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 5, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [6, 0, 0], "max": [6, 5, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [6, 0, 2.8]},
-      {"type": "rectangle", "class": "wall", "min": [0, 5, 0], "max": [6, 5, 2.8]},
-      )" + furniture + R"(
-    ]})";
-}
-
 // A cabinet against a wall and a crate on the floor, scanned from three poses with 1 cm
 // of range noise: simulated and detected once for the tests that use it.
 const Scanned& cabinetRoom() {
@@ -123,36 +70,6 @@ const Scanned& cabinetRoom() {
       {"type": "box", "class": "other", "min": [4.0, 1.0, 0], "max": [4.6, 1.5, 0.5], "omit": ["bottom"]})"),
       "cabinet.json");
   return scanned;
-}
-
-// Each patch's surface: the true plane most of its points lie on.
-std::map<std::int32_t, std::int32_t> surfaceOfPatches(const std::vector<std::int32_t>& labels,
-                                                      const std::vector<std::int32_t>& truth) {
-  std::map<std::int32_t, std::int32_t> surface_of;
-  for (const auto& [patch, by_truth] : test::truthByPatch(labels, truth)) surface_of[patch] = test::majorityTruth(by_truth);
-  return surface_of;
-}
-
-// The floor's points (true plane 0) of a scanned scene, refined with its beams, and how many
-// of them went to patches whose surface (surfaceOfPatches) is at least `first_surface`.
-struct FloorOn {
-  std::size_t floor = 0;
-  std::size_t on_others = 0;
-};
-
-FloorOn floorPointsOn(const Scanned& scanned, std::int32_t first_surface,
-                      const std::optional<PointLabelRefinement>& options = std::nullopt) {
-  std::vector<std::int32_t> labels = scanned.blockLabels();
-  refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, options.value_or(scanned.options()),
-                    scanned.beams());
-  std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, scanned.truth);
-  FloorOn counted;
-  for (std::size_t k = 0; k < scanned.points.size(); ++k) {
-    if (scanned.truth[k] != 0) continue;
-    ++counted.floor;
-    counted.on_others += labels[k] > 0 && surface_of[labels[k]] >= first_surface ? 1 : 0;
-  }
-  return counted;
 }
 
 }  // namespace
@@ -479,143 +396,4 @@ TEST_CASE("Point labels: a box's faces are refitted without the points at its ed
   CHECK(std::abs(front->normal.dot(edge) + front->offset) < 0.003);
   CHECK(std::abs(top->normal.z()) > std::cos(0.3 * M_PI / 180.0));
   CHECK(std::abs(front->normal.x()) > std::cos(0.3 * M_PI / 180.0));
-}
-
-TEST_CASE("Point labels: floor points at the foot of a turned cabinet, whose face took the floor's blocks there, stay the floor's") {
-  // The cabinet room turned 2° to the grid. Along a face's foot the detector gives some
-  // cells' level blocks (the floor's strip in that column) to the face, and the floor's own
-  // blocks lie two cells off: a floor point there had the face as its only candidate (1
-  // here before; turned 10°, 3 before and 1 now; the simulated lab turned 2-10°: single
-  // floor points on cabinets' faces, each then "touching" the floor in issue 19's held-out
-  // measure).
-  static const Scanned scanned(
-      boxRoomScene(R"({"x": 2.5, "y": 2.0, "yaw_deg": 150}, {"x": 3.5, "y": 3.2, "yaw_deg": 200},
-                      {"x": 2.0, "y": 3.5, "yaw_deg": -90})",
-                   R"({"type": "box", "class": "other", "min": [0, 1.0, 0], "max": [0.5, 3.0, 1.8], "omit": ["bottom", "x-"]},
-      {"type": "box", "class": "other", "min": [4.0, 1.0, 0], "max": [4.6, 1.5, 0.5], "omit": ["bottom"]})"),
-      "turned_cabinet.json", 2.0);
-  const FloorOn counted = floorPointsOn(scanned, 6);  // the cabinets' faces
-  const std::size_t floor = counted.floor, floor_on_faces = counted.on_others;
-  MESSAGE(floor << " floor points, " << floor_on_faces << " on the cabinet's patches");
-  REQUIRE(floor > 10000);
-  CHECK(floor_on_faces == 0);
-}
-
-TEST_CASE("Point labels: floor points at a far wall's foot go to the floor, whose blocks lie two cells off") {
-  // A 15.8 x 9.3 m hall scanned from two poses near one end (as bench/planes_sweep.py's
-  // hall-1), turned to the grid. Along a far wall's foot the floor is seen by scan lines
-  // 10-30 cm apart: its blocks there lie two cells or more from where a floor point's beam
-  // meets the floor, and the floor was looked for one cell round that place unless a
-  // vertical block ended there. A wall foot's cell holds the floor's strip as a level block
-  // of the wall's patch (as at a face's foot, where the floor's own points were already
-  // looked for two cells round): the floor counts two cells round where its beam meets it.
-  // 30 and 34 floor points on the walls before (turned 5 and 22.5°), 27 and 30 now; the rest
-  // lie within both planes' range noise, where the larger surface, the wall, keeps them.
-  const std::string hall = R"({
-    "scan_pattern": {"angular_step_deg": 0.5, "tilt_start_deg": -46, "tilt_end_deg": 46,
-                     "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
-    "poses": [{"x": 2.04, "y": 4.98, "yaw_deg": -21.1}, {"x": 3.99, "y": 5.63, "yaw_deg": 29.5}],
-    "surfaces": [
-      {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [15.76, 9.27, 0]},
-      {"type": "rectangle", "class": "ceiling", "min": [0, 0, 3.0], "max": [15.76, 9.27, 3.0]},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 9.27, 3.0]},
-      {"type": "rectangle", "class": "wall", "min": [15.76, 0, 0], "max": [15.76, 9.27, 3.0]},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [15.76, 0, 3.0]},
-      {"type": "rectangle", "class": "wall", "min": [0, 9.27, 0], "max": [15.76, 9.27, 3.0]}
-    ]})";
-  std::size_t floor_on_walls_all = 0;
-  for (const double turn : {5.0, 22.5}) {
-    CAPTURE(turn);
-    const Scanned scanned(hall, "hall_" + std::to_string(static_cast<int>(turn)) + ".json", turn);
-    const FloorOn counted = floorPointsOn(scanned, 2);  // the walls
-    MESSAGE(turn << " deg: " << counted.floor << " floor points, " << counted.on_others << " on the walls' patches");
-    REQUIRE(counted.floor > 10000);
-    floor_on_walls_all += counted.on_others;
-  }
-  CHECK(floor_on_walls_all <= 60);
-}
-
-TEST_CASE("Point labels: floor points at a far box side's foot go to the floor, whose scan lines lie cells apart there") {
-  // A 17.5 x 7.2 m hall (bench/planes_sweep.py's hall-2) scanned from near one end, a
-  // sideboard along a side wall 6-9 m out. There the floor's scan lines lie 15-30 cm
-  // apart: a line that meets the floor at the sideboard's end face has its floor points in
-  // the face's vertical blocks, and the floor's nearest block three cells or more along
-  // the line. Looked for two cells round, the floor was no candidate and the face took
-  // them (each such point makes the face "touch" the floor in issue 19's held-out measure);
-  // looked for as far as the floor's scan lines lie apart (the detector's sparse gap) it is.
-  const std::string hall = R"({
-    "scan_pattern": {"angular_step_deg": 0.5, "tilt_start_deg": -46, "tilt_end_deg": 46,
-                     "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
-    "poses": [{"x": 2.41, "y": 5.27, "yaw_deg": -3.4}, {"x": 3.57, "y": 5.02, "yaw_deg": 15.2}],
-    "surfaces": [
-      {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [17.55, 7.22, 0]},
-      {"type": "rectangle", "class": "ceiling", "min": [0, 0, 3.33], "max": [17.55, 7.22, 3.33]},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 7.22, 3.33]},
-      {"type": "rectangle", "class": "wall", "min": [17.55, 0, 0], "max": [17.55, 7.22, 3.33]},
-      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [17.55, 0, 3.33]},
-      {"type": "rectangle", "class": "wall", "min": [0, 7.22, 0], "max": [17.55, 7.22, 3.33]},
-      {"type": "box", "class": "other", "min": [8.52, 0.0, 0.0], "max": [11.07, 0.45, 0.92], "omit": ["bottom", "y-"]}
-    ]})";
-  std::size_t before_all = 0, after_all = 0;
-  for (const double turn : {0.0, 3.0, 7.0, 15.0, 22.5, 30.0}) {
-    CAPTURE(turn);
-    const Scanned scanned(hall, "hall_sideboard_" + std::to_string(static_cast<int>(10 * turn)) + ".json", turn);
-    PointLabelRefinement two_cells = scanned.options();
-    two_cells.level_gap = 0.0;
-    const FloorOn before = floorPointsOn(scanned, 6, two_cells);  // the sideboard's faces
-    const FloorOn counted = floorPointsOn(scanned, 6);
-    MESSAGE(turn << " deg: " << counted.floor << " floor points; on the sideboard's patches " << before.on_others
-                 << " looked for two cells round, " << counted.on_others << " as far as the floor's lines lie apart");
-    REQUIRE(counted.floor > 10000);
-    before_all += before.on_others;
-    after_all += counted.on_others;
-  }
-  CHECK(after_all < before_all);
-  CHECK(after_all <= 2);
-}
-
-TEST_CASE("Point labels: halfway up a chair's back, the desk top behind it does not take the strip at its height") {
-  // Part of bench/office_rooms.py's office-23 (a desk turned 43° and the chair before it,
-  // moved 0.62 and 0.75 of a 5 cm cell off the grid, as planes_sweep.py's seed 1): the
-  // chair's back (0.59-1.01 m) turned 50° stands 0.3 m before the desk's top (0.72 m). A
-  // turned face's cells hold ladders of its level blocks, so the search past two cells at a
-  // face's foot (level_gap) ran halfway up the back, and the desk's top took the back's strip
-  // at its height (136 points; in the sweep the back then lost its match). It runs only
-  // where no block of the face lies below the point.
-  static const Scanned scanned(R"({"scan_pattern": {"angular_step_deg": 0.25, "tilt_start_deg": -46, "tilt_end_deg": 46, "tilt_step_deg": 0.4, "range_sigma": 0.01, "mount_height": 1.2, "seed": 23},
- "poses": [{"x": 5.951, "y": 1.684, "yaw_deg": 60.0}, {"x": 1.056, "y": 1.832, "yaw_deg": -109.8}, {"x": 4.408, "y": 2.182, "yaw_deg": -140.4}],
- "surfaces": [
-  {"type": "rectangle", "class": "floor", "min": [0.0309, 0.0377, 0], "max": [8.6843, 4.5624, 0]},
-  {"type": "rectangle", "class": "ceiling", "min": [0.0309, 0.0377, 2.5285], "max": [8.6843, 4.5624, 2.5285]},
-  {"type": "rectangle", "class": "wall", "min": [0.0309, 0.0377, 0], "max": [0.0309, 4.5624, 2.5285], "facing": "+x"},
-  {"type": "rectangle", "class": "wall", "min": [8.6843, 0.0377, 0], "max": [8.6843, 4.5624, 2.5285], "facing": "-x"},
-  {"type": "rectangle", "class": "wall", "min": [0.0309, 0.0377, 0], "max": [8.6843, 0.0377, 2.5285], "facing": "+y"},
-  {"type": "rectangle", "class": "wall", "min": [0.0309, 4.5624, 0], "max": [8.6843, 4.5624, 2.5285], "facing": "-y"},
-  {"type": "box", "class": "other", "center": [2.2087, 2.8162, 0.7249], "size": [1.202, 0.7723, 0.03], "yaw_deg": 43.31, "classes": {"top": "table"}},
-  {"type": "cylinder", "center": [2.0384, 2.1937], "radius": 0.025, "z": [0.0, 0.7099]},
-  {"type": "cylinder", "center": [1.5772, 2.6829], "radius": 0.025, "z": [0.0, 0.7099]},
-  {"type": "cylinder", "center": [2.8403, 2.9496], "radius": 0.025, "z": [0.0, 0.7099]},
-  {"type": "cylinder", "center": [2.3791, 3.4388], "radius": 0.025, "z": [0.0, 0.7099]},
-  {"type": "box", "class": "other", "center": [2.7089, 2.0032, 0.4663], "size": [0.46, 0.46, 0.06], "yaw_deg": 50.15},
-  {"type": "box", "class": "other", "center": [2.9008, 1.843, 0.7963], "size": [0.44, 0.04, 0.42], "yaw_deg": 50.15},
-  {"type": "cylinder", "center": [2.7089, 2.0032], "radius": 0.03, "z": [0.05, 0.4363]}
- ]})", "office23_chair.json");
-  std::vector<std::int32_t> labels = scanned.blockLabels();
-  refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, scanned.options(), scanned.beams());
-  std::map<std::int32_t, bool> level;
-  for (const Plane& plane : scanned.detection.planes) level[plane.id] = std::abs(plane.normal.z()) > 0.966;
-  // The back's points: within 2 cm of its box, below its top edge.
-  const double yaw = 50.15 * M_PI / 180.0;
-  const Eigen::Vector2d centre(2.9008, 1.843), u(std::cos(yaw), std::sin(yaw)), v(-std::sin(yaw), std::cos(yaw));
-  std::size_t back = 0, back_on_level = 0;
-  for (std::size_t k = 0; k < scanned.points.size(); ++k) {
-    const Point& p = scanned.points[k];
-    const Eigen::Vector2d d = p.head<2>() - centre;
-    if (std::abs(d.dot(u)) > 0.24 || std::abs(d.dot(v)) > 0.04 || p.z() < 0.57 || p.z() > 0.99) continue;
-    ++back;
-    back_on_level += labels[k] > 0 && level[labels[k]] ? 1 : 0;
-  }
-  MESSAGE(back << " points of the chair's back below its top edge, " << back_on_level << " on level patches");
-  REQUIRE(back > 1000);
-  CHECK(back_on_level <= 5);
 }
