@@ -24,10 +24,11 @@ struct PointLabelRefinement {
   double min_tolerance = 0.01;  // m, and always within this
   double band = 0.0;            // m, the first refit takes the points this close to the detected
                                 // plane (e.g. ε + half a cell); 0 = all the patch's points
-  double level_gap = 0.0;       // m: where a point's candidates are plumb faces alone (at a box
-                                // side's foot), how far round its cell level patches' blocks are
-                                // looked for: as far as a floor's scan lines lie apart (the
-                                // detection's ErmsmConfig::sparse_gap); 0 = two cells
+  double level_gap = 0.0;       // m: at a face's foot (its blocks above the point, none below)
+                                // where a point's candidates are plumb faces alone, how far round
+                                // its cell level patches' blocks are looked for: as far as a
+                                // floor's scan lines lie apart (the detection's
+                                // ErmsmConfig::sparse_gap); 0 = two cells
 };
 
 // The σ that caps a patch's tolerance (PointLabelRefinement::noise) for labels of
@@ -68,10 +69,10 @@ struct BeamOrigins {
 // the blocks of its own and the 8 neighbouring cells that reach its height (level
 // patches' further round at a face's foot: `level_gap`), or none (0) if it lies on none.
 // Nearest: along the point's beam when `beams` are given (range noise lies along the
-// beam), else in units of each plane's tolerance. Where two
-// surfaces meet at an edge a point on both goes to the larger patch; with beams, each
-// counts only where its patch is, a plane the beam meets further off than that patch's
-// range noise reaches is no candidate beside one it meets within it, and a point past a
+// beam), else in units of each plane's tolerance. Where two surfaces meet at an edge a
+// point on both goes to the larger patch; with beams, each counts only where its patch
+// is, a plane the beam meets further off than that patch's range noise reaches is no
+// candidate beside one it meets within it, and a point past a
 // surface's plane from its scanner, in that surface's noise tail, is the surface's, not
 // that of a patch ending at the plane on the scanner's side (a box on the floor).
 // With `noise` set (it caps the tolerances), a point left on none goes back to its block's
