@@ -125,14 +125,9 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   std::vector<double> along_tolerance =
       beams.origin_of_point.empty() ? std::vector<double>(slots, std::numeric_limits<double>::infinity())
                                     : alongTolerances(points, slot_of_point, fitted, beamOf, options.sigmas);
+  // The patches each point may lie on (gather), read from `fitted` and `along_tolerance`
+  // as the fits below move them.
   LabelCandidates candidates_of(map, points, slot_of_point, ids, fitted, along_tolerance, options.level_gap);
-  const auto gather = [&candidates_of](std::size_t index, const Eigen::Vector3d& beam,
-                                       std::array<Candidate, kMaxCandidates>& out,
-                                       std::array<Candidate, kMaxCandidates>* tail = nullptr,
-                                       std::size_t* tail_found = nullptr) {
-    return candidates_of.gather(index, beam, out, tail, tail_found);
-  };
-  const auto levelReach = [&candidates_of](const CellIndex& cell, double z) { return candidates_of.levelReach(cell, z); };
   // A third fit without the points at an edge: those within tolerance of the plane of a
   // patch round them that meets theirs (not parallel). The blocks along an edge collect
   // both surfaces' points, and the two fits above keep those within a band (then the
@@ -159,7 +154,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
       const std::uint32_t own = slot_of_point[index];
       if (own == 0 && !heights_wanted) continue;
       std::array<Candidate, kMaxCandidates> candidates;
-      const std::size_t found = gather(index, Eigen::Vector3d::Zero(), candidates);
+      const std::size_t found = candidates_of.gather(index, Eigen::Vector3d::Zero(), candidates);
       if (heights_wanted && found == 1) sole[index] = candidates[0].slot;
       if (own == 0) continue;
       for (std::size_t c = 0; c < found; ++c)
@@ -217,7 +212,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     if (!(q.z() >= heights[c.slot].low && q.z() <= heights[c.slot].high)) return false;
     const auto at = map.findCellOf(q.x(), q.y());
     if (!at || !q.allFinite()) return false;
-    const std::int32_t near = std::abs(plane.normal.z()) >= kLevelCosine ? levelReach(*at, q.z()) : kNear;
+    const std::int32_t near = std::abs(plane.normal.z()) >= kLevelCosine ? candidates_of.levelReach(*at, q.z()) : kNear;
     for (std::int32_t di = -near; di <= near; ++di)
       for (std::int32_t dj = -near; dj <= near; ++dj)
         for (const Block& block : map.blocks(CellIndex{at->i + di, at->j + dj}))
@@ -275,7 +270,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     const Eigen::Vector3d beam = beamOf(index);
     std::array<Candidate, kMaxCandidates> candidates, tail;
     std::size_t tail_found = 0;
-    std::size_t found = gather(index, beam, candidates, &tail, &tail_found);
+    std::size_t found = candidates_of.gather(index, beam, candidates, &tail, &tail_found);
     // A surface returns a beam from its front only: with the scanner known, the patches seen
     // from the other side of their planes (seenFrom: their points' scanners) give way where
     // one faces it. A cabinet seen from two corners: its top's points by the far edges went
