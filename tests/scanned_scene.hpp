@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,32 @@ inline std::string boxRoomScene(const std::string& poses, const std::string& fur
       {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [6, 0, 2.8]},
       {"type": "rectangle", "class": "wall", "min": [0, 5, 0], "max": [6, 5, 2.8]},
       )" + furniture + R"(
+    ]})";
+}
+
+// A width x depth x height m hall (its floor, ceiling and walls are true planes 0-5) with
+// the given poses and furniture (none: empty), scanned as bench/office_rooms.py's halls are:
+// a coarser laser than boxRoomScene's (0.5 deg beams, 1 deg lines, ±46 deg), 1 cm of noise.
+inline std::string hallScene(double width, double depth, double height, const std::string& poses,
+                             const std::string& furniture = "") {
+  const auto number = [](double value) {
+    std::ostringstream text;
+    text << value;
+    return text.str();
+  };
+  const std::string w = number(width), d = number(depth), h = number(height);
+  return R"({
+    "scan_pattern": {"angular_step_deg": 0.5, "tilt_start_deg": -46, "tilt_end_deg": 46,
+                     "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
+    "poses": [)" + poses + R"(],
+    "surfaces": [
+      {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [)" + w + ", " + d + R"(, 0]},
+      {"type": "rectangle", "class": "ceiling", "min": [0, 0, )" + h + R"(], "max": [)" + w + ", " + d + ", " + h + R"(]},
+      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, )" + d + ", " + h + R"(]},
+      {"type": "rectangle", "class": "wall", "min": [)" + w + R"(, 0, 0], "max": [)" + w + ", " + d + ", " + h + R"(]},
+      {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [)" + w + ", 0, " + h + R"(]},
+      {"type": "rectangle", "class": "wall", "min": [0, )" + d + R"(, 0], "max": [)" + w + ", " + d + ", " + h + R"(]})" +
+         (furniture.empty() ? "" : ",\n      " + furniture) + R"(
     ]})";
 }
 
