@@ -207,10 +207,11 @@ class SeamSearch {
     return large;
   }
 
-  // Two groups are two surfaces where they meet a step apart: blocks of the one within two
-  // cells of the other's lie further apart along the normal than the step, in the median
-  // (across a row of blocks that hold both), over as many pairs as a patch has blocks (a
-  // seam is a line: 3DTK's floor at 5 cm cells, ε 9 cm, met a group 6 cm off in 3 pairs).
+  // Two groups side by side are two surfaces where they meet a step apart: blocks of the
+  // one within two cells of the other's lie further apart along the normal than the step,
+  // in the median (across a row of blocks that hold both), over as many pairs as a patch
+  // has blocks (a seam is a line: 3DTK's floor at 5 cm cells, ε 9 cm, met a group 6 cm off
+  // in 3 pairs).
   // Groups that meet within the step are one surface. The pieces are the joined groups
   // that meet another across a step; a group that meets none says nothing of where it
   // lies, and its blocks go with the rest (assignTheRest).
@@ -220,19 +221,26 @@ class SeamSearch {
     for (std::size_t a = 0; a < large.size(); ++a)
       for (const std::uint32_t id : large[a]) large_of[indexOf(id)] = static_cast<int>(a);
     std::map<std::pair<int, int>, std::vector<float>> meetings;
+    std::map<std::pair<int, int>, std::size_t> stacked;  // pairs of blocks in one cell
     for (std::size_t n = 0; n < blocks_.size(); ++n) {
       const int a = large_of[n];
       if (a < 0) continue;
+      const CellIndex cell = grid_.blocks()[blocks_[n]].cell;
       forEachNear(n, 2, [&](std::size_t m) {
-        if (large_of[m] > a)
-          meetings[{a, large_of[m]}].push_back(static_cast<float>(std::abs(samples_[m].along - samples_[n].along)));
+        if (large_of[m] <= a) return;
+        meetings[{a, large_of[m]}].push_back(static_cast<float>(std::abs(samples_[m].along - samples_[n].along)));
+        if (grid_.blocks()[blocks_[m]].cell == cell) ++stacked[{a, large_of[m]}];
       });
     }
     std::vector<std::size_t> joined(large.size());
     std::iota(joined.begin(), joined.end(), std::size_t{0});
     std::vector<char> stepped(large.size(), 0);
     for (auto& [pair, differences] : meetings) {
-      if (differences.size() < min_blocks_) continue;
+      // Groups over the same cells are layers, not two surfaces side by side: views of one
+      // floor registered apart (3DTK's at 5 cm cells: two layers 6.6 cm apart over 3.8 m²,
+      // the upper one cut off and called "other"). The sheets (sheets.hpp) judge layers.
+      const auto layered = stacked.find(pair);
+      if (differences.size() < min_blocks_ || (layered != stacked.end() && layered->second >= min_blocks_)) continue;
       const auto a = static_cast<std::size_t>(pair.first), b = static_cast<std::size_t>(pair.second);
       if (medianOf(differences) > step_) {
         stepped[a] = stepped[b] = 1;
