@@ -67,10 +67,19 @@ constexpr double kNeighbourQuantile = 0.95;
 // The seam search on one patch's blocks (ascending ids; their label `id`).
 class SeamSearch {
  public:
-  SeamSearch(const BlockGrid& grid, const PatchSet& set, std::size_t k, const SeamConfig& config)
-      : grid_(grid), set_(set), blocks_(set.blocks[k]), id_(set.planes[k].id), config_(config),
+  // `slots`: one entry per block of the grid, all -1; they are again when the search ends.
+  SeamSearch(const BlockGrid& grid, const PatchSet& set, std::size_t k, const SeamConfig& config,
+             std::vector<std::int32_t>& slots)
+      : grid_(grid), blocks_(set.blocks[k]), config_(config),
         min_blocks_(static_cast<std::size_t>(std::max(config.min_blocks, 1))),
-        normal_(set.planes[k].normal.normalized()), origin_(set.planes[k].centroid) {}
+        normal_(set.planes[k].normal.normalized()), origin_(set.planes[k].centroid), slots_(slots) {
+    for (std::size_t n = 0; n < blocks_.size(); ++n) slots_[blocks_[n]] = static_cast<std::int32_t>(n);
+  }
+  ~SeamSearch() {
+    for (const std::uint32_t id : blocks_) slots_[id] = -1;
+  }
+  SeamSearch(const SeamSearch&) = delete;
+  SeamSearch& operator=(const SeamSearch&) = delete;
 
   // The pieces (each its blocks, ascending; the largest first), or none where the patch
   // holds no seam.
@@ -90,15 +99,13 @@ class SeamSearch {
   }
 
  private:
-  std::size_t indexOf(std::uint32_t id) const {
-    return static_cast<std::size_t>(std::lower_bound(blocks_.begin(), blocks_.end(), id) - blocks_.begin());
-  }
+  std::size_t indexOf(std::uint32_t id) const { return static_cast<std::size_t>(slots_[id]); }
   // Visits the index of every block of the patch in the cells within `radius` of block
   // `n`'s.
   template <typename Visit>
   void forEachNear(std::size_t n, int radius, Visit&& visit) const {
     grid_.forEachNeighbour(grid_.blocks()[blocks_[n]].cell, radius, [&](std::uint32_t other) {
-      if (set_.labels[other] == id_) visit(indexOf(other));
+      if (slots_[other] >= 0) visit(static_cast<std::size_t>(slots_[other]));
     });
   }
   // Whether block `n` may seed or measure: three points or more, spread as one surface's.
@@ -155,10 +162,10 @@ class SeamSearch {
   }
 
   // Groups grown from the blocks whose points spread least (one surface's, most surely):
-  // a block joins where its mean lies within the step of the group's blocks within two
-  // cells of it (their mean, by points), so that a block across the seam, halfway between
-  // the surfaces, may join one side but carries no group across to the other. Compared
-  // with those neighbours, not with the group's plane: the patch's normal leans between
+  // a block joins where its mean lies within the step of the mean (by points) of the
+  // group's blocks round the block it is reached from, as that one joined, so that a block
+  // across the seam, halfway between the surfaces, may join one side but carries no group
+  // across to the other. Compared with those neighbours, not with the group's plane: the patch's normal leans between
   // the surfaces (two desks side by side: 1.1° off level, 2.6 cm over one desk). Blocks of
   // one or two points join but seed none (a coarse scan's desk at 5 cm cells: 45 % of its
   // blocks; without them its groups stayed pieces a third of its size). Returns the
@@ -170,6 +177,7 @@ class SeamSearch {
     std::stable_sort(order.begin(), order.end(),
                      [&](std::size_t a, std::size_t b) { return samples_[a].spread < samples_[b].spread; });
     std::vector<int> group_of(blocks_.size(), -1);
+    std::vector<double> local(blocks_.size(), 0.0);  // as each block joined: its group's mean round it
     std::vector<std::vector<std::uint32_t>> large;
     std::vector<std::uint32_t> members;
     std::vector<std::size_t> frontier;
@@ -184,18 +192,17 @@ class SeamSearch {
         const std::size_t n = frontier.back();
         frontier.pop_back();
         members.push_back(blocks_[n]);
+        double along = 0.0, weight = 0.0;
+        forEachNear(n, 1, [&](std::size_t q) {
+          if (group_of[q] != group) return;
+          along += samples_[q].weight * samples_[q].along;
+          weight += samples_[q].weight;
+        });
+        local[n] = along / weight;
         forEachNear(n, 1, [&](std::size_t m) {
-          if (group_of[m] >= 0 || !joinable(m)) return;
-          double along = 0.0, weight = 0.0;
-          forEachNear(m, 2, [&](std::size_t q) {
-            if (group_of[q] != group) return;
-            along += samples_[q].weight * samples_[q].along;
-            weight += samples_[q].weight;
-          });
-          if (weight > 0.0 && std::abs(samples_[m].along - along / weight) <= step_) {
-            group_of[m] = group;
-            frontier.push_back(m);
-          }
+          if (group_of[m] >= 0 || !joinable(m) || std::abs(samples_[m].along - local[n]) > step_) return;
+          group_of[m] = group;
+          frontier.push_back(m);
         });
       }
       if (members.size() >= min_blocks_ &&
@@ -299,9 +306,7 @@ class SeamSearch {
   }
 
   const BlockGrid& grid_;
-  const PatchSet& set_;
   const std::vector<std::uint32_t>& blocks_;
-  std::int32_t id_;
   const SeamConfig& config_;
   std::size_t min_blocks_;
   Eigen::Vector3d normal_;
@@ -309,6 +314,7 @@ class SeamSearch {
   std::vector<Sample> samples_;
   double spread_ = 0.0;  // m, the median of the blocks' points' RMS along the normal
   double step_ = 0.0;    // m, the least difference a seam is
+  std::vector<std::int32_t>& slots_;  // per block of the grid, its index in blocks_ (-1: none)
 };
 
 }  // namespace
@@ -316,8 +322,9 @@ class SeamSearch {
 std::vector<int> splitAtSeams(const BlockGrid& grid, PatchSet& set, const SeamConfig& config) {
   std::vector<int> cut_from(set.planes.size(), -1);
   const std::size_t count = set.planes.size();
+  std::vector<std::int32_t> slots(grid.size(), -1);
   for (std::size_t k = 0; k < count; ++k) {
-    std::vector<std::vector<std::uint32_t>> pieces = SeamSearch(grid, set, k, config).pieces();
+    std::vector<std::vector<std::uint32_t>> pieces = SeamSearch(grid, set, k, config, slots).pieces();
     if (pieces.empty()) continue;
     const Plane patch = set.planes[k];
     const CandidatePlane reference{patch.normal.cast<float>(), patch.centroid.cast<float>()};
