@@ -71,7 +71,8 @@ TEST_CASE("Seams: two touching desks whose tops differ by 2 cm, scanned with 1 c
       R"({"type": "box", "class": "other", "min": [1.5, 2.0, 0.72], "max": [2.9, 2.75, 0.75], "omit": ["bottom"]},
       {"type": "box", "class": "other", "min": [2.9, 2.0, 0.70], "max": [4.3, 2.75, 0.73], "omit": ["bottom"]})";
   const std::string poses =
-      R"({"x": 1.0, "y": 1.0, "yaw_deg": 30}, {"x": 5.0, "y": 4.0, "yaw_deg": 210}, {"x": 3.0, "y": 4.2, "yaw_deg": -90})";
+      R"({"x": 1.0, "y": 1.0, "yaw_deg": 30}, {"x": 5.0, "y": 4.0, "yaw_deg": 210},
+      {"x": 3.0, "y": 4.2, "yaw_deg": -90})";
   for (const double turn : {0.0, 10.0}) {
     CAPTURE(turn);
     const test::Scanned scanned(test::boxRoomScene(poses, furniture), "touching_desks.json", turn);
@@ -106,7 +107,8 @@ TEST_CASE("Seams: two desks side by side 1.5 cm apart in height, points 3 mm off
     const PlaneDetection detection = detectPlanes(scene.map());
     std::vector<const Plane*> desks = test::levelPatchesAt(detection, 0.74);
     REQUIRE(desks.size() >= 2);
-    std::sort(desks.begin(), desks.end(), [](const Plane* a, const Plane* b) { return a->centroid.z() > b->centroid.z(); });
+    std::sort(desks.begin(), desks.end(),
+              [](const Plane* a, const Plane* b) { return a->centroid.z() > b->centroid.z(); });
     // Each about its own 1.05 m² at its own height.
     CHECK(desks.front()->area < 1.4);
     CHECK(desks.back()->area < 1.4);

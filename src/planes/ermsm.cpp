@@ -61,24 +61,20 @@ double defaultEpsilon(bool at_points, double cell_size, double noise) {
                    : std::max(cell_size, std::min(3.0 * noise, 0.05));
 }
 
-// One family per plane for mergeCoplanar from the splits' (per plane, the index of the patch
-// it was split from, -1 for none; any may be shorter than the others): the faces of one
-// crease split, the steps of one ramp, the pieces of one seam cut. The merge after a crease
-// split anywhere in the map joined the steps of fr079's flight at 10 cm cells (7 with 8, 10
-// to 12 into a ramp again) in 5 of 12 placements of the grid (bench/real_seeds.py
-// --placements). A plane takes the first split's family it has, each split's numbered after
-// the one before.
-std::vector<int> keptApart(const std::vector<int>& faces_of, const std::vector<int>& flights,
-                           const std::vector<int>& seams_of) {
-  std::vector<int> families(std::max({faces_of.size(), flights.size(), seams_of.size()}), -1);
+// One family per plane for mergeCoplanar from two splits' (per plane, the index of the patch
+// it was split from, -1 for none; either may be shorter than the other): the faces of one
+// crease split, and the steps of one ramp. The merge after a crease split anywhere in the map
+// joined the steps of fr079's flight at 10 cm cells (7 with 8, 10 to 12 into a ramp again) in
+// 5 of 12 placements of the grid (bench/real_seeds.py --placements). Faces keep their family;
+// a step takes its ramp's, numbered after every plane's index.
+std::vector<int> keptApart(const std::vector<int>& faces_of, const std::vector<int>& flights) {
+  std::vector<int> families(std::max(faces_of.size(), flights.size()), -1);
   const auto offset = static_cast<int>(families.size());
   for (std::size_t k = 0; k < families.size(); ++k) {
     if (k < faces_of.size() && faces_of[k] >= 0) {
       families[k] = faces_of[k];
     } else if (k < flights.size() && flights[k] >= 0) {
       families[k] = offset + flights[k];
-    } else if (k < seams_of.size() && seams_of[k] >= 0) {
-      families[k] = 2 * offset + seams_of[k];
     }
   }
   return families;
@@ -232,14 +228,12 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
     dropCurved(grid, patches, radians(config.kappa_deg), std::max(config.epsilon, config.max_epsilon));
     std::vector<int> flights;
     splitSteps(grid, patches, {config.noise, config.min_patch_blocks, config.min_patch_area}, &flights);
-    const std::vector<int> seams_of = splitAtSeams(
-        grid, patches, {radians(config.kappa_deg), config.noise, config.min_patch_blocks, config.min_patch_area});
     const std::vector<int> faces_of = splitCreases(
         grid, patches,
         {config.noise, config.epsilon, radians(config.kappa_deg), config.min_patch_blocks, config.min_patch_area});
     if (!faces_of.empty())
       mergeCoplanar(grid, patches, std::min(config.epsilon + 0.5 * grid.cellSize(), sheetStep(config.noise, grid.cellSize())),
-                    2.0 * radians(config.kappa_deg) / 3.0, config.noise, keptApart(faces_of, flights, seams_of));
+                    2.0 * radians(config.kappa_deg) / 3.0, config.noise, keptApart(faces_of, flights));
   }
   // The map's surface, each block's bottom weighted by its points: whether anything lies
   // under the lowest level patch.
@@ -258,6 +252,13 @@ PlaneDetection detectOn(MLMap& map, const ErmsmConfig& input_config, double bloc
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));
   std::vector<std::uint8_t> landings;
   stats.height_reference = classifyPlanes(patches.planes, {}, bottoms, &landings);
+  // Surfaces a step apart in one level patch (seams.hpp), once σ is known; not the floor's
+  // and the ceiling's pieces, which are one level each whatever their heights (mergeLevels).
+  if (sheets && hasPointStats(map))
+    splitAtSeams(grid, patches,
+                 {radians(config.kappa_deg), config.noise, config.min_patch_blocks, config.min_patch_area,
+                  patchPassThreads(grid, config.threads)},
+                 &landings);
   mergeLevels(grid, patches, radians(config.kappa_deg), sheets ? config.noise : 0.0, &landings);
   labelCeilingPieces(patches.planes, {}, landings);
   tracePendingOutlines(grid, patches, patchPassThreads(grid, config.threads));  // the merged levels'

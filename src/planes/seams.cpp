@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "detector.hpp"
 #include "median.hpp"
 #include "mlmap/planes/classify.hpp"
 
@@ -108,6 +109,13 @@ class SeamSearch {
       if (slots_[other] >= 0) visit(static_cast<std::size_t>(slots_[other]));
     });
   }
+  // Visits the index of every block of the patch in the cells one apart from block `n`'s
+  // (its own included; measure() lists them).
+  template <typename Visit>
+  void forEachAdjacent(std::size_t n, Visit&& visit) const {
+    for (std::size_t k = adjacent_first_[n]; k < adjacent_first_[n + 1]; ++k)
+      visit(static_cast<std::size_t>(adjacent_[k]));
+  }
   // Whether block `n` may seed or measure: three points or more, spread as one surface's.
   bool measured(std::size_t n) const {
     return samples_[n].spread >= 0.0 && samples_[n].spread <= kOneSurfaceSpread * spread_;
@@ -146,16 +154,25 @@ class SeamSearch {
     // patch instead of 96, the ANYmal landing 72 % instead of 100, three of the tilted
     // steps' blocks lost theirs. On the simulated offices it is 0.9-1.1 times the spread
     // (a seam between two desks is under 1 % of a patch's pairs).
+    // Each block's neighbours (cells one apart, its own included), once: the groups' growth
+    // walks them twice per block.
+    adjacent_first_.assign(1, 0);
+    adjacent_.clear();
+    for (std::size_t n = 0; n < blocks_.size(); ++n) {
+      forEachNear(n, 1, [&](std::size_t m) { adjacent_.push_back(static_cast<std::uint32_t>(m)); });
+      adjacent_first_.push_back(adjacent_.size());
+    }
     std::vector<float> differences;
     for (std::size_t n = 0; n < blocks_.size(); ++n) {
       if (!measured(n)) continue;
-      forEachNear(n, 1, [&](std::size_t m) {
-        if (blocks_[m] > blocks_[n] && measured(m))
+      forEachAdjacent(n, [&](std::size_t m) {
+        if (m > n && measured(m))
           differences.push_back(static_cast<float>(std::abs(samples_[m].along - samples_[n].along)));
       });
     }
     if (differences.size() < 2 * min_blocks_) return false;
-    const auto high = differences.begin() + static_cast<long>(kNeighbourQuantile * static_cast<double>(differences.size()));
+    const auto high =
+        differences.begin() + static_cast<long>(kNeighbourQuantile * static_cast<double>(differences.size()));
     std::nth_element(differences.begin(), high, differences.end());
     step_ = kSeamStep * std::max<double>(spread_, *high);
     return true;
@@ -165,9 +182,9 @@ class SeamSearch {
   // a block joins where its mean lies within the step of the mean (by points) of the
   // group's blocks round the block it is reached from, as that one joined, so that a block
   // across the seam, halfway between the surfaces, may join one side but carries no group
-  // across to the other. Compared with those neighbours, not with the group's plane: the patch's normal leans between
-  // the surfaces (two desks side by side: 1.1° off level, 2.6 cm over one desk). Blocks of
-  // one or two points join but seed none (a coarse scan's desk at 5 cm cells: 45 % of its
+  // across to the other. Compared with those neighbours, not with the group's plane: the
+  // patch's normal leans between the surfaces (two desks side by side: 1.1° off level, 2.6 cm
+  // over one desk). Blocks of one or two points join but seed none (a coarse scan's desk at 5 cm cells: 45 % of its
   // blocks; without them its groups stayed pieces a third of its size). Returns the
   // groups as large as a patch must be, their ids ascending.
   std::vector<std::vector<std::uint32_t>> largeGroups() const {
@@ -193,13 +210,13 @@ class SeamSearch {
         frontier.pop_back();
         members.push_back(blocks_[n]);
         double along = 0.0, weight = 0.0;
-        forEachNear(n, 1, [&](std::size_t q) {
+        forEachAdjacent(n, [&](std::size_t q) {
           if (group_of[q] != group) return;
           along += samples_[q].weight * samples_[q].along;
           weight += samples_[q].weight;
         });
         local[n] = along / weight;
-        forEachNear(n, 1, [&](std::size_t m) {
+        forEachAdjacent(n, [&](std::size_t m) {
           if (group_of[m] >= 0 || !joinable(m) || std::abs(samples_[m].along - local[n]) > step_) return;
           group_of[m] = group;
           frontier.push_back(m);
@@ -302,7 +319,8 @@ class SeamSearch {
       }
     }
     for (std::vector<std::uint32_t>& piece : pieces) piece.clear();
-    for (std::size_t n = 0; n < blocks_.size(); ++n) pieces[static_cast<std::size_t>(assigned[n])].push_back(blocks_[n]);
+    for (std::size_t n = 0; n < blocks_.size(); ++n)
+      pieces[static_cast<std::size_t>(assigned[n])].push_back(blocks_[n]);
   }
 
   const BlockGrid& grid_;
@@ -315,21 +333,39 @@ class SeamSearch {
   double spread_ = 0.0;  // m, the median of the blocks' points' RMS along the normal
   double step_ = 0.0;    // m, the least difference a seam is
   std::vector<std::int32_t>& slots_;  // per block of the grid, its index in blocks_ (-1: none)
+  std::vector<std::size_t> adjacent_first_;  // per block, where its neighbours start in adjacent_
+  std::vector<std::uint32_t> adjacent_;
 };
 
 }  // namespace
 
-std::vector<int> splitAtSeams(const BlockGrid& grid, PatchSet& set, const SeamConfig& config) {
-  std::vector<int> cut_from(set.planes.size(), -1);
+std::size_t splitAtSeams(const BlockGrid& grid, PatchSet& set, const SeamConfig& config,
+                         std::vector<std::uint8_t>* landings) {
   const std::size_t count = set.planes.size();
-  std::vector<std::int32_t> slots(grid.size(), -1);
+  const auto searched = [&](std::size_t k) {
+    const PlaneClass label = set.planes[k].label;
+    return label != PlaneClass::Floor && label != PlaneClass::Ceiling;
+  };
+  // Each patch's search reads the set only: all of them first, on the threads, each with
+  // its own slots.
+  std::vector<std::vector<std::vector<std::uint32_t>>> pieces_of(count);
+#pragma omp parallel num_threads(teamSize(config.threads)) if (count > 1 && config.threads != 1)
+  {
+    std::vector<std::int32_t> slots(grid.size(), -1);
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t k = 0; k < static_cast<std::int64_t>(count); ++k) {
+      const auto patch = static_cast<std::size_t>(k);
+      if (searched(patch)) pieces_of[patch] = SeamSearch(grid, set, patch, config, slots).pieces();
+    }
+  }
+  std::size_t cut = 0;
   for (std::size_t k = 0; k < count; ++k) {
-    std::vector<std::vector<std::uint32_t>> pieces = SeamSearch(grid, set, k, config, slots).pieces();
+    std::vector<std::vector<std::uint32_t>>& pieces = pieces_of[k];
     if (pieces.empty()) continue;
+    ++cut;
     const Plane patch = set.planes[k];
     const CandidatePlane reference{patch.normal.cast<float>(), patch.centroid.cast<float>()};
     const int raster_step = set.outline_frames[k].step;
-    cut_from[k] = static_cast<int>(k);
     for (std::size_t n = 0; n < pieces.size(); ++n) {
       std::size_t slot = k;
       if (n > 0) {
@@ -338,7 +374,10 @@ std::vector<int> splitAtSeams(const BlockGrid& grid, PatchSet& set, const SeamCo
         set.blocks.emplace_back();
         set.outline_frames.emplace_back();
         set.outline_runs.emplace_back();
-        cut_from.push_back(static_cast<int>(k));
+        if (landings != nullptr) {
+          landings->resize(slot, 0);
+          landings->push_back(k < landings->size() ? (*landings)[k] : 0);
+        }
       }
       Patch piece;
       piece.blocks = std::move(pieces[n]);
@@ -346,6 +385,7 @@ std::vector<int> splitAtSeams(const BlockGrid& grid, PatchSet& set, const SeamCo
       piece.raster_step = raster_step;
       Plane described = describePatch(grid, piece, reference, config.kappa_rad, config.noise);
       described.id = static_cast<std::int32_t>(slot + 1);
+      described.label = patch.label;
       described.source = patch.source;
       described.candidates = patch.candidates;
       for (const std::uint32_t id : piece.blocks) set.labels[id] = described.id;
@@ -355,7 +395,7 @@ std::vector<int> splitAtSeams(const BlockGrid& grid, PatchSet& set, const SeamCo
       set.blocks[slot] = std::move(piece.blocks);
     }
   }
-  return cut_from;
+  return cut;
 }
 
 }  // namespace mlmap

@@ -10,6 +10,7 @@
 // patch holds a seam, and the blocks either side of it are two surfaces.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "patch_set.hpp"
@@ -21,20 +22,25 @@ struct SeamConfig {
   double noise = 0.0;      // m, σ, describePatch's
   int min_blocks = 6;      // a piece needs as many blocks (ErmsmConfig::min_patch_blocks)
   double min_area = 0.0;   // m², and as much surface (ErmsmConfig::min_patch_area)
+  int threads = 1;         // patches searched at once (0: OpenMP's default)
 };
 
-// Each patch whose blocks keep their points is cut at its seams: its blocks are joined
-// where neighbours (cells one apart) differ along its normal by at most kSeamStep times
-// the patch's spread (the median over its blocks of their points' RMS along the normal);
-// blocks of fewer than three points, and blocks whose points spread by more than
-// kOneSurfaceSpread times it (a cell across the seam, holding both surfaces), join none.
-// Where two or more of the groups are as large as a patch must be, and their own planes
-// lie more than kSeamStep spreads apart where they meet, each is a patch; the other
-// blocks go to the piece whose plane lies nearest their points among those that hold a
-// block within two cells (else among all). The first piece keeps the patch's id, the
-// others are appended, their outlines pending. Returns, per plane, the index of the
-// patch it was cut from (-1 for none): a later merge keeps them apart.
-std::vector<int> splitAtSeams(const BlockGrid& grid, PatchSet& set, const SeamConfig& config);
+// After classification: each level patch but the floor's and the ceiling's (their pieces
+// are one level each whatever their heights: mergeLevels) whose blocks keep their points is
+// cut at its seams. Its blocks are grouped where neighbours (cells one apart) differ along
+// its normal by at most kSeamStep times the patch's roughness (the larger of its blocks'
+// points' spread, the median over its blocks of their RMS along the normal, and the 95th
+// percentile of its neighbouring blocks' differences); blocks whose points spread by more
+// than kOneSurfaceSpread times the spread (a cell across the seam, holding both surfaces)
+// join none. Where two groups as large as a patch must be meet side by side (not over the
+// same cells: layers) and their blocks within two cells of each other lie more than the
+// step apart in the median, each is a patch; the other blocks go to the piece whose plane
+// lies nearest their points among those that hold a block within two cells (else among
+// all). The first piece keeps the patch's id and the others are appended with its class
+// and its flag in `landings` (classifyPlanes'; may be null), their outlines pending.
+// Returns the number of patches cut.
+std::size_t splitAtSeams(const BlockGrid& grid, PatchSet& set, const SeamConfig& config,
+                         std::vector<std::uint8_t>* landings = nullptr);
 
 // How far apart, in the patch's spreads, two surfaces must lie to be told apart:
 // normal densities of equal spread s are bimodal from 2 s apart, and at 3 s their points
