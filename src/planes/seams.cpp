@@ -65,7 +65,7 @@ PiecePlane fitPiece(const BlockGrid& grid, const std::vector<std::uint32_t>& blo
 // surface's roughness (the rest: a seam's, and outliers).
 constexpr double kNeighbourQuantile = 0.95;
 
-// The seam search on one patch's blocks (ascending ids; their label `id`).
+// The seam search on one patch (its blocks: ascending ids).
 class SeamSearch {
  public:
   // `slots`: one entry per block of the grid, all -1; they are again when the search ends.
