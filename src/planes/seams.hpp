@@ -6,8 +6,9 @@
 // points spread by across it: seen at a glancing angle, a desk top's points lie within a
 // few mm of it (1 cm of range noise at 13° below the horizon: 2.3 mm up), so the step is
 // many times their spread. Each block keeps its points' moments: where neighbouring blocks
-// of a patch differ along its normal by more than its points' own spread allows, the
-// patch holds a seam, and the blocks either side of it are two surfaces.
+// of a patch differ along its normal by more than the patch's own roughness allows (its
+// points' spread, or how far its neighbouring blocks differ elsewhere), the patch holds a
+// seam, and the blocks either side of it are two surfaces.
 #pragma once
 
 #include <cstdint>
