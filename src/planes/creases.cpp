@@ -50,23 +50,8 @@ std::vector<int> splitCreases(const BlockGrid& grid, PatchSet& set, const Crease
         described.source = original.source;
         described.candidates = original.candidates;
         const OutlineFrame frame{described.normal, described.centroid, true};
-        std::size_t slot = k;
-        if (first) {
-          first = false;
-          described.id = original.id;
-        } else {
-          slot = set.planes.size();
-          described.id = static_cast<std::int32_t>(slot + 1);
-          set.planes.emplace_back();
-          set.blocks.emplace_back();
-          set.outline_frames.emplace_back();
-          set.outline_runs.emplace_back();
-        }
-        for (const std::uint32_t id : piece.blocks) set.labels[id] = described.id;
-        set.planes[slot] = std::move(described);
-        set.blocks[slot] = std::move(piece.blocks);
-        set.outline_frames[slot] = frame;
-        set.outline_runs[slot] = {};
+        placePatch(set, first ? k : set.planes.size(), std::move(described), std::move(piece.blocks), frame);
+        first = false;
       }
     }
     if (first) {  // every piece too small: the patch as it was

@@ -248,6 +248,22 @@ Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePl
   return plane;
 }
 
+void placePatch(PatchSet& set, std::size_t slot, Plane plane, std::vector<std::uint32_t> blocks,
+                const OutlineFrame& frame) {
+  if (slot == set.planes.size()) {
+    set.planes.emplace_back();
+    set.blocks.emplace_back();
+    set.outline_frames.emplace_back();
+    set.outline_runs.emplace_back();
+  }
+  plane.id = static_cast<std::int32_t>(slot + 1);
+  for (const std::uint32_t id : blocks) set.labels[id] = plane.id;
+  set.planes[slot] = std::move(plane);
+  set.blocks[slot] = std::move(blocks);
+  set.outline_frames[slot] = frame;
+  set.outline_runs[slot] = {};
+}
+
 void dropPatches(PatchSet& set, const std::vector<bool>& drop) {
   if (std::none_of(drop.begin(), drop.end(), [](bool d) { return d; })) return;
   const std::size_t count = set.planes.size();

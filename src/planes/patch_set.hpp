@@ -53,6 +53,12 @@ double surfaceOf(const BlockGrid& grid, const std::vector<std::uint32_t>& blocks
 Plane describePatch(const BlockGrid& grid, const Patch& patch, const CandidatePlane& reference, double kappa_rad,
                     double noise);
 
+// Puts a patch into the set at `slot`: in place of the plane there, or appended where `slot`
+// is the set's size. The plane takes the slot's id (slot + 1) and its blocks that label, its
+// outline is traced later on `frame` (pending), from no raster runs.
+void placePatch(PatchSet& set, std::size_t slot, Plane plane, std::vector<std::uint32_t> blocks,
+                const OutlineFrame& frame);
+
 // Removes the patches flagged in `drop` (one flag per plane): their blocks go back to no
 // patch, the others are renumbered 1..n in order and the block labels follow.
 void dropPatches(PatchSet& set, const std::vector<bool>& drop);

@@ -367,32 +367,21 @@ std::size_t splitAtSeams(const BlockGrid& grid, PatchSet& set, const SeamConfig&
     const CandidatePlane reference{patch.normal.cast<float>(), patch.centroid.cast<float>()};
     const int raster_step = set.outline_frames[k].step;
     for (std::size_t n = 0; n < pieces.size(); ++n) {
-      std::size_t slot = k;
-      if (n > 0) {
-        slot = set.planes.size();
-        set.planes.emplace_back();
-        set.blocks.emplace_back();
-        set.outline_frames.emplace_back();
-        set.outline_runs.emplace_back();
-        if (landings != nullptr) {
-          landings->resize(slot, 0);
-          landings->push_back(k < landings->size() ? (*landings)[k] : 0);
-        }
+      const std::size_t slot = n == 0 ? k : set.planes.size();
+      if (n > 0 && landings != nullptr) {
+        landings->resize(slot, 0);
+        landings->push_back(k < landings->size() ? (*landings)[k] : 0);
       }
       Patch piece;
       piece.blocks = std::move(pieces[n]);
       piece.surface = surfaceOf(grid, piece.blocks);
       piece.raster_step = raster_step;
       Plane described = describePatch(grid, piece, reference, config.kappa_rad, config.noise);
-      described.id = static_cast<std::int32_t>(slot + 1);
       described.label = patch.label;
       described.source = patch.source;
       described.candidates = patch.candidates;
-      for (const std::uint32_t id : piece.blocks) set.labels[id] = described.id;
-      set.outline_frames[slot] = OutlineFrame{described.normal, described.centroid, true, raster_step};
-      set.outline_runs[slot] = {};
-      set.planes[slot] = std::move(described);
-      set.blocks[slot] = std::move(piece.blocks);
+      const OutlineFrame frame{described.normal, described.centroid, true, raster_step};
+      placePatch(set, slot, std::move(described), std::move(piece.blocks), frame);
     }
   }
   return cut;

@@ -285,23 +285,12 @@ std::size_t splitSteps(const BlockGrid& grid, PatchSet& set, const StepConfig& c
     for (const std::uint32_t id : set.blocks[k]) set.labels[id] = 0;  // those on no step stay so
     std::vector<std::size_t> slots;  // per step, its place in the set: the ramp's, then appended
     for (std::size_t n = 0; n < pieces.size(); ++n) {
-      std::size_t slot = k;
-      if (n > 0) {
-        slot = set.planes.size();
-        set.planes.emplace_back();
-        set.blocks.emplace_back();
-        set.outline_frames.emplace_back();
-        set.outline_runs.emplace_back();
-      }
+      const std::size_t slot = n == 0 ? k : set.planes.size();
       Plane& plane = pieces[n].plane;
-      plane.id = static_cast<std::int32_t>(slot + 1);
       plane.source = ramp.source;
       plane.candidates = ramp.candidates;
-      for (const std::uint32_t id : pieces[n].blocks) set.labels[id] = plane.id;
-      set.outline_frames[slot] = OutlineFrame{plane.normal, plane.centroid, true};
-      set.outline_runs[slot] = {};
-      set.planes[slot] = std::move(plane);
-      set.blocks[slot] = std::move(pieces[n].blocks);
+      const OutlineFrame frame{plane.normal, plane.centroid, true};
+      placePatch(set, slot, std::move(plane), std::move(pieces[n].blocks), frame);
       slots.push_back(slot);
       if (flights != nullptr) {
         flights->resize(set.planes.size(), -1);
