@@ -63,6 +63,29 @@ std::int32_t surfaceAt(const test::Scanned& scanned, double z, double x0, double
   return best;
 }
 
+// A cloud of world points mapped at `cell`, its planes detected and its points labelled:
+// how many lie in the region `inside` marks, and how many of those on its largest patch.
+struct RegionOnPatches {
+  std::size_t points = 0;
+  std::size_t on_largest = 0;
+};
+template <typename Inside>
+RegionOnPatches regionOnPatches(const Scan& cloud, double cell, Inside&& inside) {
+  MLMap map(cell);
+  for (std::size_t k = 0; k < cloud.size(); ++k) map.insert(cloud.worldPoint(k), cloud.variance(k));
+  detectPlanes(map);
+  const std::vector<std::int32_t> labels = labelPoints(map, cloud);
+  std::map<std::int32_t, std::size_t> by_patch;
+  RegionOnPatches region;
+  for (std::size_t k = 0; k < cloud.size(); ++k) {
+    if (!inside(cloud.worldPoint(k))) continue;
+    ++region.points;
+    if (labels[k] > 0) ++by_patch[labels[k]];
+  }
+  for (const auto& [patch, count] : by_patch) region.on_largest = std::max(region.on_largest, count);
+  return region;
+}
+
 }  // namespace
 
 TEST_CASE("Seams: two touching desks whose tops differ by 2 cm, scanned with 1 cm of range noise, are two patches") {
@@ -149,24 +172,13 @@ TEST_CASE("Seams: Bobkov's registered office cloud keeps its table top in one pa
   const Scan cloud = io::readPcd(*data / "bobkov_office_labels" / "room2_gt_fine.pcd");
   for (const double cell : {0.05, 0.1}) {
     CAPTURE(cell);
-    MLMap map(cell);
-    for (std::size_t k = 0; k < cloud.size(); ++k) map.insert(cloud.worldPoint(k), cloud.variance(k));
-    detectPlanes(map);
-    const std::vector<std::int32_t> labels = labelPoints(map, cloud);
     // The top as bench/annotations/bobkov_room2.json marks it: its box, within 4 cm of z 2.171.
-    std::map<std::int32_t, std::size_t> by_patch;
-    std::size_t top = 0;
-    for (std::size_t k = 0; k < cloud.size(); ++k) {
-      const Point p = cloud.worldPoint(k);
-      if (p.x() < 0.65 || p.x() > 3.35 || p.y() < 0.95 || p.y() > 2.5 || std::abs(p.z() - 2.171) > 0.04) continue;
-      ++top;
-      if (labels[k] > 0) ++by_patch[labels[k]];
-    }
-    REQUIRE(top > 5000);
-    std::size_t most = 0;
-    for (const auto& [patch, count] : by_patch) most = std::max(most, count);
-    MESSAGE(top << " points of the top, " << most << " on its largest patch");
-    CHECK(static_cast<double>(most) > 0.9 * static_cast<double>(top));
+    const RegionOnPatches top = regionOnPatches(cloud, cell, [](const Point& p) {
+      return p.x() >= 0.65 && p.x() <= 3.35 && p.y() >= 0.95 && p.y() <= 2.5 && std::abs(p.z() - 2.171) <= 0.04;
+    });
+    REQUIRE(top.points > 5000);
+    MESSAGE(top.points << " points of the top, " << top.on_largest << " on its largest patch");
+    CHECK(static_cast<double>(top.on_largest) > 0.9 * static_cast<double>(top.points));
   }
 }
 
@@ -183,23 +195,12 @@ TEST_CASE("Seams: plane_seg's ANYmal stair map keeps its upper landing in one pa
   const Scan cloud = io::readPcd(*data / "plane_seg_stairs" / "ori_entrance_stair_climb_06.pcd");
   for (const double cell : {0.05, 0.1}) {
     CAPTURE(cell);
-    MLMap map(cell);
-    for (std::size_t k = 0; k < cloud.size(); ++k) map.insert(cloud.worldPoint(k), cloud.variance(k));
-    detectPlanes(map);
-    const std::vector<std::int32_t> labels = labelPoints(map, cloud);
     // The landing as bench/annotations/stairs_anymal.json marks it (its box).
-    std::map<std::int32_t, std::size_t> by_patch;
-    std::size_t landing = 0;
-    for (std::size_t k = 0; k < cloud.size(); ++k) {
-      const Point p = cloud.worldPoint(k);
-      if (p.x() < 3.42 || p.x() > 5.3 || p.y() < -0.4 || p.y() > 2.2 || p.z() < 1.15 || p.z() > 1.38) continue;
-      ++landing;
-      if (labels[k] > 0) ++by_patch[labels[k]];
-    }
-    REQUIRE(landing > 5000);
-    std::size_t most = 0;
-    for (const auto& [patch, count] : by_patch) most = std::max(most, count);
-    MESSAGE(landing << " points of the landing, " << most << " on its largest patch");
-    CHECK(static_cast<double>(most) > 0.9 * static_cast<double>(landing));
+    const RegionOnPatches landing = regionOnPatches(cloud, cell, [](const Point& p) {
+      return p.x() >= 3.42 && p.x() <= 5.3 && p.y() >= -0.4 && p.y() <= 2.2 && p.z() >= 1.15 && p.z() <= 1.38;
+    });
+    REQUIRE(landing.points > 5000);
+    MESSAGE(landing.points << " points of the landing, " << landing.on_largest << " on its largest patch");
+    CHECK(static_cast<double>(landing.on_largest) > 0.9 * static_cast<double>(landing.points));
   }
 }
