@@ -40,6 +40,7 @@ const char* cueName(registration::UpCue cue) {
   switch (cue) {
     case registration::UpCue::Poses: return "the axis the scans turn about";
     case registration::UpCue::Positions: return "the plane the sensors moved in";
+    case registration::UpCue::Image: return "the down of a depth camera's image (an organized PCD)";
     case registration::UpCue::Planes: return "the planes most surfaces face";
     case registration::UpCue::None: break;
   }
@@ -181,13 +182,15 @@ void ScanReading::resolveUp(const std::string& up, bool level) {
     return;
   }
   // Warned only on strong evidence that the line differs from z: the scans turn about
-  // another axis, or half the planar cells face it and its points lie on both sides of
-  // the sensor. A cloud registered by others (PCD VIEWPOINT at an arbitrary origin: PCL's
-  // room scans, Bobkov's room, the stair scans) gives no sign evidence and split families
-  // (44-51 % of the planar cells), and a camera's single view (office1) shows the far wall
-  // as much as the floor: warnings there would be wrong.
+  // another axis, a depth camera's image has its down along it, or half the planar cells
+  // face it and its points lie on both sides of the sensor. A cloud registered by others
+  // (PCD VIEWPOINT at an arbitrary origin: PCL's room scans, Bobkov's room, the stair scans)
+  // gives no sign evidence and split families (44-51 % of the planar cells), and a camera's
+  // single view (office1) shows the far wall as much as the floor: the planes alone would
+  // warn wrongly there.
   const bool strong = estimate.line_from == registration::UpCue::Poses ||
                       estimate.line_from == registration::UpCue::Positions ||
+                      estimate.line_from == registration::UpCue::Image ||
                       (estimate.line_from == registration::UpCue::Planes && estimate.planar_share >= 0.5 &&
                        estimate.below_share >= 0.1 && estimate.below_share <= 0.9);
   if (estimate.faces_no_axis) {

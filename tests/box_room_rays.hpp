@@ -34,4 +34,26 @@ inline std::vector<BoxRay> boxRoomRays(int rays, const Eigen::Vector3d& low, con
   return hits;
 }
 
+// A depth camera's view of the z-up box room seen from the origin: the rays within 30 deg
+// across and 23 deg up or down of its forward axis (a Kinect's field of view), `turn` its
+// orientation in the room (identity: looking along +x, level), the points in its optical
+// frame (x right, y down the image, z forward).
+inline std::vector<Eigen::Vector3d> cameraViewPoints(const Eigen::Matrix3d& turn, int rays, const Eigen::Vector3d& low,
+                                                     const Eigen::Vector3d& high) {
+  Eigen::Matrix3d optical_to_room;  // columns: the optical x, y, z in the room
+  optical_to_room.col(0) = -Eigen::Vector3d::UnitY();
+  optical_to_room.col(1) = -Eigen::Vector3d::UnitZ();
+  optical_to_room.col(2) = Eigen::Vector3d::UnitX();
+  optical_to_room = turn * optical_to_room;
+  std::vector<Eigen::Vector3d> points;
+  for (const BoxRay& ray : boxRoomRays(rays, low, high)) {
+    const Eigen::Vector3d in_camera = optical_to_room.transpose() * ray.direction;
+    if (in_camera.z() <= 0.0 || std::abs(in_camera.x()) > std::tan(0.52) * in_camera.z() ||
+        std::abs(in_camera.y()) > std::tan(0.40) * in_camera.z())
+      continue;
+    points.push_back(ray.range * in_camera);
+  }
+  return points;
+}
+
 }  // namespace mlmap::test

@@ -264,6 +264,31 @@ TEST_CASE("CLI: a y-up cloud is warned about, and --up auto or --up y turns it z
   CHECK_FALSE(mlmap::test::contains(result.output, "warning"));
 }
 
+TEST_CASE("CLI: a depth camera's organized cloud, y-up by its VIEWPOINT, is warned about and turned by --up auto") {
+  // PCL's office1.pcd: a Kinect's 640 x 480 view whose far wall holds most planar cells;
+  // until session 63 nothing warned and `--up auto` kept z (the wall's axis).
+  mlmap::test::TempDir dir;
+  const std::vector<Eigen::Vector3d> view =
+      mlmap::test::cameraViewPoints(Eigen::Matrix3d::Identity(), 60000, {-2.0, -3.0, -1.0}, {4.0, 1.0, 1.5});
+  const std::size_t columns = view.size() / 4;  // four image rows
+  std::string text = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH " + std::to_string(columns) +
+                     "\nHEIGHT 4\nVIEWPOINT 0 0 0 0 1 0 0\nPOINTS " + std::to_string(4 * columns) + "\nDATA ascii\n";
+  for (std::size_t k = 0; k < 4 * columns; ++k)
+    text += std::to_string(view[k].x()) + " " + std::to_string(view[k].y()) + " " + std::to_string(view[k].z()) + "\n";
+  const std::string scan = (dir / "view.pcd").string(), map = (dir / "view.mlmap").string();
+  mlmap::test::writeText(scan, text);
+  auto result = runCli("--quiet build --no-octree -o " + map + " " + scan);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  CHECK(mlmap::test::contains(result.output, "warning: the data look y-up, not z-up (from the down of a depth camera's image"));
+  result = runCli("build --no-octree --up auto -o " + map + " " + scan);
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  CHECK(mlmap::test::contains(result.output, "up is +y"));
+  // Turned z-up: the room's floor 1 m below the camera and its ceiling 1.5 m above.
+  const auto bounds = infoOf(map)["bounds"];
+  CHECK(bounds["min"][2].get<double>() == doctest::Approx(-1.0).epsilon(0.1));
+  CHECK(bounds["max"][2].get<double>() < 1.6);
+}
+
 TEST_CASE("CLI: planes says when no floor is in view, and not when one is") {
   mlmap::test::TempDir dir;
   // A cloud cut above its floor (as Bobkov's room 2 is): a table top at 0.75 m, its legs'

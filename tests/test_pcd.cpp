@@ -128,6 +128,7 @@ TEST_CASE("pcd: ascii without VERSION, with padding, COUNT>1 fields and NaN poin
   // qw=0, qx=1: half a turn about x.
   CHECK(scan.pose.translation() == Eigen::Vector3d(1, 2, 3));
   CHECK(scan.pose.linear().isApprox(Eigen::Vector3d(1, -1, -1).asDiagonal().toDenseMatrix()));
+  CHECK(scan.from_image);  // HEIGHT 2: organized, a depth image's rows (the up axis's cue)
 }
 
 TEST_CASE("pcd: other spellings of VERSION are accepted") {
@@ -215,6 +216,7 @@ TEST_CASE("pcd: PCL's test clouds") {
     CHECK(mean.z() < 10.0);
     // VIEWPOINT 0 0 0 0 1 0 0: half a turn about x.
     CHECK(scan.pose.linear().isApprox(Eigen::Vector3d(1, -1, -1).asDiagonal().toDenseMatrix()));
+    CHECK(scan.from_image);
     MESSAGE("office1.pcd: " << scan.size() << " finite points");
   }
   SUBCASE("table_scene_mug_stereo_textured.pcd: binary_compressed with rgba") {
@@ -231,6 +233,7 @@ TEST_CASE("pcd: PCL's test clouds") {
     CHECK(scan.size() == 3283);
     CHECK(scan.points[0] == Point(1.068F, 0.094720997F, -0.016231F));
     CHECK(scan.labels.empty());
+    CHECK_FALSE(scan.from_image);  // HEIGHT 1: unorganized
   }
 }
 

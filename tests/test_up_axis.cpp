@@ -162,6 +162,55 @@ TEST_CASE("Up axis: planes that face no coordinate axis give no line (a tilted c
   CHECK_FALSE(estimateUpAxis({turned(roomScan(), Eigen::Matrix3d::Identity())}).faces_no_axis);
 }
 
+namespace {
+
+// A depth camera's view of the z-up room (test::cameraViewPoints), with the pose PCL's
+// office1.pcd has (VIEWPOINT: a half turn about x), whose world is then the optical frame
+// upside down: y-up where the camera is level.
+Scan cameraView(const Eigen::Matrix3d& turn, bool from_image = true) {
+  Scan scan;
+  scan.from_image = from_image;
+  scan.points = test::cameraViewPoints(turn, 60000, {-2.0, -3.0, -1.0}, {4.0, 1.0, 1.5});
+  scan.pose = Pose(about(Eigen::Vector3d::UnitX(), 180.0));
+  return scan;
+}
+
+}  // namespace
+
+TEST_CASE("Up axis: a depth camera's single view is up where its image's down says, not where the wall it faces does") {
+  // PCL's office1.pcd, a Kinect's organized cloud of an office: its VIEWPOINT makes the world
+  // y-up, its far wall holds most planar cells, and `--up auto` read it as z-up (the wall's
+  // axis) and nothing warned. Here the wall ahead outweighs the floor strip in view likewise.
+  const Scan view = cameraView(Eigen::Matrix3d::Identity());
+  REQUIRE(view.points.size() > 3000);
+  const auto estimate = estimateUpAxis({view});
+  CHECK(estimate.line_from == UpCue::Image);
+  CHECK(estimate.up.isApprox(Eigen::Vector3d::UnitY()));
+  CHECK_FALSE(estimate.faces_no_axis);
+  CHECK(estimate.below_share > 0.5);  // the floor in view lies below the camera
+  // The same points read as an unorganized cloud: the planes alone, and the far wall wins.
+  const auto planes_only = estimateUpAxis({cameraView(Eigen::Matrix3d::Identity(), false)});
+  CHECK(planes_only.line_from == UpCue::Planes);
+  CHECK_FALSE(planes_only.up.isApprox(Eigen::Vector3d::UnitY()));
+
+  // A spinning lidar's organized scan (rows of rings) lies all round its sensor: no image.
+  Scan rings = turned(roomScan(), about(Eigen::Vector3d::UnitX(), -90.0));
+  rings.from_image = true;
+  const auto lidar = estimateUpAxis({rings});
+  CHECK(lidar.line_from == UpCue::Planes);
+  CHECK(lidar.up.isApprox(Eigen::Vector3d::UnitY()));
+
+  // A camera looking down 32 deg at a table, turned 30 deg in the room (PCL's
+  // table_scene_mug_stereo_textured.pcd): the image's down is the nearest axis to up, and
+  // the surfaces say the view is tilted.
+  const Scan down_at = cameraView(about(Eigen::Vector3d::UnitZ(), 30.0) * about(Eigen::Vector3d::UnitY(), 32.0));
+  REQUIRE(down_at.points.size() > 3000);
+  const auto tilted = estimateUpAxis({down_at});
+  CHECK(tilted.line_from == UpCue::Image);
+  CHECK(tilted.up.isApprox(Eigen::Vector3d::UnitY()));
+  CHECK(tilted.faces_no_axis);
+}
+
 // A scanner standing off level (3DTK's three scans: 4.3 deg of pitch and 1 deg of roll by
 // `mlmap calibrate`): the room's floor and ceiling lean off z, and its walls across the map's
 // cell rows (build --level turns them back).

@@ -21,6 +21,10 @@ struct Scan {
   Pose pose = Pose::Identity();     // sensor frame -> world frame
   std::vector<double> variances;    // m², per point; empty means kDefaultRangeVariance
   std::vector<std::int32_t> labels; // optional per-point label (ground truth, plane id); empty if none
+  // Read from a depth image (an organized PCD, HEIGHT > 1): a camera's points in its optical
+  // frame, x right, y down the image, z forward (PCL's grabbers and ROS's depth images), so
+  // the image's down is a cue to which way is up (registration/up_axis.hpp).
+  bool from_image = false;
 
   std::size_t size() const { return points.size(); }
   double variance(std::size_t index) const {

@@ -224,6 +224,7 @@ Scan readPcd(const std::filesystem::path& path) {
 
   Scan scan;
   scan.pose = header.viewpoint;
+  scan.from_image = header.rows > 1;
   const std::size_t body_start = file.offset();
   switch (header.encoding) {
     case Encoding::Ascii: readAscii(header, lines, bytes.size() - body_start, scan); break;

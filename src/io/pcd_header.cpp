@@ -145,6 +145,7 @@ Header parsePcdHeader(TextLines& lines) {
                                     std::to_string(organized_points));
   }
   header.points = organized_points;
+  header.rows = rows;
 
   std::optional<std::size_t> x, y, z;
   for (std::size_t i = 0; i < names.size(); ++i) {

@@ -27,6 +27,7 @@ enum class Encoding { Ascii, Binary, BinaryCompressed };
 struct Header {
   std::vector<Field> fields;
   std::uint64_t points = 0;
+  std::uint64_t rows = 1;  // HEIGHT: more than one row is an organized cloud (a depth image)
   std::size_t point_bytes = 0;
   Pose viewpoint = Pose::Identity();
   Encoding encoding = Encoding::Ascii;

@@ -88,6 +88,29 @@ int movedPlaneAxis(const std::vector<Pose>& poses) {
   return snappedAxis(solver.eigenvectors().col(0));
 }
 
+// A depth image is a camera's view when this share of its points lies in front of it (its
+// optical frame's +z); a spinning lidar's organized scan (rows of rings) lies all round.
+constexpr double kMinInFront = 0.95;
+
+// The signed coordinate axis the image's down (the optical frame's +y, turned by each pose)
+// lies along, summed over the scans read from depth images that are camera views; zero
+// where there are none or the sum is more than kSnapCos off every axis (a camera looking
+// down at a table).
+Eigen::Vector3d imageDown(const std::vector<Scan>& scans) {
+  Eigen::Vector3d summed = Eigen::Vector3d::Zero();
+  for (const Scan& scan : scans) {
+    if (!scan.from_image || scan.points.empty()) continue;
+    const auto in_front = std::count_if(scan.points.begin(), scan.points.end(),
+                                        [](const Point& point) { return point.z() > 0.0; });
+    if (static_cast<double>(in_front) < kMinInFront * static_cast<double>(scan.points.size())) continue;
+    summed += scan.pose.linear() * Eigen::Vector3d::UnitY();
+  }
+  const int axis = summed.norm() > 0.0 ? snappedAxis(summed) : -1;
+  Eigen::Vector3d down = Eigen::Vector3d::Zero();
+  if (axis >= 0) down[axis] = summed[axis] > 0.0 ? 1.0 : -1.0;
+  return down;
+}
+
 // A level cell's normal lies this far from the level surfaces' at most: more is a ramp, a
 // chair's tilted seat or a cell holding a step's edge. The simulated lab pitched 3 deg and
 // rolled 1 deg (3.16 deg) measures 3.15 deg with it.
@@ -171,10 +194,20 @@ UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig
     for (const Scan& scan : scans) poses.push_back(scan.pose);
   }
   int line = turnAxis(poses);
+  const Eigen::Vector3d down = imageDown(scans);
   if (line >= 0) {
     estimate.line_from = UpCue::Poses;
   } else if ((line = movedPlaneAxis(poses)) >= 0) {
     estimate.line_from = UpCue::Positions;
+  } else if (!down.isZero()) {
+    Eigen::Index axis = 0;
+    down.cwiseAbs().maxCoeff(&axis);
+    line = static_cast<int>(axis);
+    estimate.line_from = UpCue::Image;
+    // A camera looking down at a table: its image's down is the nearest axis to up, but
+    // the surfaces say the view is tilted.
+    estimate.faces_no_axis = estimate.planar_cells >= kMinPlanarCells &&
+                             *std::max_element(facing.begin(), facing.end()) < kMinPlanarCells;
   } else if (const auto most = std::max_element(facing.begin(), facing.end()); *most >= kMinPlanarCells) {
     // A family of its own: where the planar cells face no coordinate axis (a camera looking
     // down at a table, its plane 32 deg from every axis), no axis is the line.
@@ -191,8 +224,10 @@ UpAxisEstimate estimateUpAxis(const std::vector<Scan>& scans, const UpAxisConfig
   estimate.below_share =
       on_family[axis] == 0 ? 0.5 : static_cast<double>(below[axis]) / static_cast<double>(on_family[axis]);
   estimate.up = Eigen::Vector3d::Zero();
-  // A tie keeps the positive axis: no evidence against the data's own convention.
-  estimate.up[line] = estimate.below_share >= 0.5 ? 1.0 : -1.0;
+  // A tie keeps the positive axis: no evidence against the data's own convention. The
+  // image's down gives its own sign: a view of a wall puts it all on one side of the camera.
+  if (estimate.line_from == UpCue::Image) estimate.up = -down;
+  else estimate.up[line] = estimate.below_share >= 0.5 ? 1.0 : -1.0;
   return estimate;
 }
 

@@ -5,7 +5,10 @@
 //  1. the line: when the scans' rotations differ, the axis they turn about (a robot
 //     turns about up only); else, when the sensors moved in a plane (a robot or a trolley
 //     carries its scanner at one height; a drone flying up and down a wall would mislead
-//     this), that plane's normal; else the axis the most
+//     this), that plane's normal; else, for a depth camera's view (Scan::from_image, its
+//     points in front of it), the axis its image's down lies along (sign included: a camera
+//     is held with its image upright; one view faces a wall as much as the floor, and
+//     PCL's office1.pcd faces its far wall most); else the axis the most
 //     planar cells face (floors and ceilings, desks and seats; walls split between two
 //     axes, but a long corridor's two walls outnumber its floor and ceiling);
 //  2. the sign: of the points on that family's planes, more lie below their sensor
@@ -22,7 +25,7 @@
 
 namespace mlmap::registration {
 
-enum class UpCue { None, Poses, Positions, Planes };
+enum class UpCue { None, Poses, Positions, Image, Planes };
 
 struct UpAxisEstimate {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // a signed coordinate axis, world frame
@@ -31,7 +34,8 @@ struct UpAxisEstimate {
   double below_share = 0.0;       // of the points on those cells, the share below their sensor
   std::size_t planar_cells = 0;
   // Planar cells enough to tell, but too few of them facing any coordinate axis (within
-  // 15 deg) for a line: the data are tilted (a camera looking down at a table), up stays +z.
+  // 15 deg) for a line: the data are tilted (a camera looking down at a table), up stays +z,
+  // or is the image's down where that is a cue.
   bool faces_no_axis = false;
 };
 
