@@ -133,6 +133,8 @@ TEST_CASE("Point labels: at 3 cm of noise and 5 cm cells a floor point at a box 
   const SideCount count = boxSidesOnFloor(0.03, 0.05);
   REQUIRE(count.sides >= 8);
   CHECK(count.floor_points <= 15);
-  // At 3 cm of noise a side gives up its strip within 4 σ of the floor (12 of 45 cm).
-  CHECK(count.side_points_kept * 10 >= count.side_points * 6);
+  // At 3 cm of noise a side gives up its strip within 4 σ of the floor (12 of 45 cm), and
+  // since session 63 the one within its box top's tolerance (9 cm: a top keeps its rim over a
+  // face below it, likeliest): 60 % of its points or more kept before, 50 % since.
+  CHECK(count.side_points_kept * 100 >= count.side_points * 45);
 }
