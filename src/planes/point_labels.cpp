@@ -353,8 +353,9 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     chosen = surfaceTail(chosen, points[index], std::span(near.data(), near_found), fitted, kSurfaceTailTolerances,
                          kSurfaceTailRatio);
     // The rim's strip is the top's (likeliest) whichever rule above gave it to the face below:
-    // a point on the top's plane within its tolerance, behind the face's plane (the rules for
-    // a surface's tails took 2-60 such points of a generated desk's top to its front).
+    // a point within the top's tolerance of its plane (the rules for a surface's tails took
+    // 2-60 points of a generated desk's top, on its plane and 1.6-2.5 cm behind the front's,
+    // to the front).
     if (chosen != 0)
       for (std::size_t c = 0; c < near_found; ++c)
         if (underRim(near[c].slot, chosen, points[index]) &&
