@@ -255,19 +255,18 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   // `top`'s tolerance and a cell, the outline's raster). A riser keeps the rule of size: its
   // top strip within a tread's tolerance is a fifth to a third of it, and the stairwell of
   // bench/stairs_bench.py lost 9 of its 37 steps found (each tread took 10 % of a riser).
-  std::vector<std::pair<double, double>> face_heights(slots, {-std::numeric_limits<double>::infinity(),
-                                                              std::numeric_limits<double>::infinity()});
+  // Empty (no rim) where a patch has neither.
+  std::vector<HeightRange> face_heights(slots);
   for (std::size_t slot = 1; slot < slots; ++slot) {
     const Plane* plane = plane_of_slot[slot];
     if (plane == nullptr) continue;
+    HeightRange& range = face_heights[slot];
     if (!plane->bounds.isEmpty()) {
-      face_heights[slot] = {plane->bounds.min().z(), plane->bounds.max().z()};
-    } else if (!plane->outline.empty()) {
-      auto& [low, high] = face_heights[slot];
-      std::swap(low, high);
+      range = {static_cast<float>(plane->bounds.min().z()), static_cast<float>(plane->bounds.max().z())};
+    } else {
       for (const Eigen::Vector3d& corner : plane->outline) {
-        low = std::min(low, corner.z());
-        high = std::max(high, corner.z());
+        range.low = std::min(range.low, static_cast<float>(corner.z()));
+        range.high = std::max(range.high, static_cast<float>(corner.z()));
       }
     }
   }
@@ -277,8 +276,8 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     if (std::abs(level.normal.z()) < kLevelCosine || std::abs(fitted[face].normal.z()) >= kLevelCosine) return false;
     if (seen_from[top] == 0 || (seen_from[top] > 0) != (level.normal.z() > 0.0)) return false;
     const double height = -(level.normal.x() * p.x() + level.normal.y() * p.y() + level.offset) / level.normal.z();
-    const auto [low, high] = face_heights[face];
-    return high <= height + level.tolerance + reach && low < height - riser_max;
+    const HeightRange& range = face_heights[face];
+    return range.high <= height + level.tolerance + reach && range.low < height - riser_max;
   };
   // A point left on no patch goes back to its block's where it lies within that patch's
   // own noise (ownNoise: σ of its points within `band` of its plane), beyond the map's
