@@ -243,10 +243,11 @@ enum RimFace : std::uint8_t { kRimTop, kRimFace, kRimFloor };
 // A level top from x0 to x1 and from `front` back by `depth` at `height`, a face flush with its
 // front edge down to the floor, and the floor in front of it, seen from `scanner`: the face
 // sampled every 1 cm (seen head on), the top every 3 cm (seen at a grazing angle), the floor
-// every 2 cm as far as `floor_x1`, with 1 cm of range noise, mapped at 5 cm.
+// every `floor_step` as far as `floor_x1`, with 1 cm of range noise, mapped at 5 cm.
 struct Rim : Scanned {
   struct Shape {
     double x0, x1, front, depth, height, floor_x1;
+    double floor_step = 0.02;
   };
 
   Rim(const Point& scanner, unsigned seed, const Shape& shape) : Scanned(0.05, {scanner}, seed) {
@@ -255,8 +256,8 @@ struct Rim : Scanned {
         add(0, Point(x, y, shape.height), kRimTop);
     for (double x = shape.x0 + 0.005; x < shape.x1; x += 0.01)
       for (double z = 0.005; z < shape.height; z += 0.01) add(0, Point(x, shape.front, z), kRimFace);
-    for (double x = 0.01; x < shape.floor_x1; x += 0.02)
-      for (double y = 0.01; y < shape.front; y += 0.02) add(0, Point(x, y, 0.0), kRimFloor);
+    for (double x = 0.01; x < shape.floor_x1; x += shape.floor_step)
+      for (double y = 0.01; y < shape.front; y += shape.floor_step) add(0, Point(x, y, 0.0), kRimFloor);
     detect();
   }
 
@@ -306,4 +307,70 @@ TEST_CASE("Point labels: a riser under a tread's nosing keeps its top strip wher
   const auto [on_tread, all] = scene.shareOf(labels, kRimFace, tread);
   MESSAGE("riser points on its patch: " << kept * 100 << " %, on the tread's: " << on_tread * 100 << " % of " << all);
   CHECK(on_tread < 0.05);
+}
+
+TEST_CASE("Point labels: the floor keeps its strip at the foot of a larger cabinet front standing on it") {
+  // By size a face seen head on, with more points than the floor seen at a grazing angle, took
+  // the floor's points within both planes' tolerances at its foot: a generated office's
+  // cabinet front (70,000 points against the floor's 27,000) took 158 of them
+  // (bench/planes_sweep.py, office-15), and a face that touches the floor by one point is a
+  // false plane in an instance score of the labelled surfaces. A sideboard 2 m wide and 1 m
+  // high seen from 2 m in front of it at 1.2 m, the floor every 4 cm: the front with four
+  // times the floor's points.
+  const Rim scene(Point(2.0, 0.0, 1.2), 17,
+                  {.x0 = 1.0, .x1 = 3.0, .front = 2.0, .depth = 0.5, .height = 1.0, .floor_x1 = 4.0, .floor_step = 0.04});
+  const std::vector<std::int32_t> labels = scene.labels();
+  const std::int32_t floor = scene.patchOf(labels, kRimFloor), front = scene.patchOf(labels, kRimFace);
+  REQUIRE(floor > 0);
+  REQUIRE(front > 0);
+  REQUIRE(floor != front);
+  // The floor's points within 3 cm (its tolerance, 3 σ) in front of the face.
+  const auto at_foot = [&](std::size_t k) { return scene.points[k].y() > 2.0 - 0.03; };
+  const auto [foot_on_front, foot_points] = scene.shareOn(labels, kRimFloor, front, at_foot);
+  const auto [front_kept, front_points] = scene.shareOf(labels, kRimFace, front);
+  MESSAGE("floor points at the foot on the front's patch: " << foot_on_front * foot_points << " of " << foot_points
+                                                           << "; front points on it: " << front_kept * 100 << " % of "
+                                                           << front_points);
+  CHECK(foot_points > 20);
+  CHECK(foot_on_front == 0.0);
+  // The front gives up no more than the strip within the floor's tolerance (3 σ of 1 m).
+  CHECK(front_kept > 0.95);
+}
+
+namespace {
+
+enum BackPart : std::uint8_t { kDeskTop, kBackWall, kDeskFloor };
+
+// A desk top at 0.75 m against a wall 4.2 m wide, the wall seen only above the desk's height
+// (furniture along it hides its foot), the floor in front, seen from 1.3 m in front of the desk
+// at 1.2 m with 1 cm of range noise, mapped at 5 cm.
+struct DeskAgainstWall : Scanned {
+  DeskAgainstWall() : Scanned(0.05, {Point(2.1, 0.3, 1.2)}, 19) {
+    for (double x = 1.5075; x < 2.7; x += 0.03)
+      for (double y = 1.6075; y < 2.2; y += 0.03) add(0, Point(x, y, 0.75), kDeskTop);
+    for (double x = 0.005; x < 4.2; x += 0.02)
+      for (double z = 0.755; z < 2.5; z += 0.02) add(0, Point(x, 2.2, z), kBackWall);
+    for (double x = 0.01; x < 4.2; x += 0.03)
+      for (double y = 0.01; y < 1.6; y += 0.03) add(0, Point(x, y, 0.0), kDeskFloor);
+    detect();
+  }
+};
+
+}  // namespace
+
+TEST_CASE("Point labels: a wall seen only above a desk against it does not stand on the desk") {
+  // A face keeps its foot's strip for the level patch it stands on (the test above), judged by
+  // heights and by extent: a wall whose foot is hidden at a desk's height reaches down to the
+  // desk's plane like a monitor standing on it, but runs past the desk's ends. By heights alone
+  // the desk took the wall's strip at its back edge and touched it (PCL's room_scan2's far wall
+  // at 10 cm, two desk-level pieces).
+  const DeskAgainstWall scene;
+  const std::vector<std::int32_t> labels = scene.labels();
+  const std::int32_t desk = scene.patchOf(labels, kDeskTop), wall = scene.patchOf(labels, kBackWall);
+  REQUIRE(desk > 0);
+  REQUIRE(wall > 0);
+  REQUIRE(desk != wall);
+  const auto [wall_on_desk, wall_points] = scene.shareOn(labels, kBackWall, desk, [](std::size_t) { return true; });
+  MESSAGE("wall points on the desk's patch: " << wall_on_desk * wall_points << " of " << wall_points);
+  CHECK(wall_on_desk == 0.0);
 }

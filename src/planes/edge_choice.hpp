@@ -185,17 +185,20 @@ std::vector<std::int8_t> seenFrom(std::span<const Point> points, std::span<const
 // 0.05 m: 122 of a wall's 2,226 points, some 0.4 cm from its plane and 6 cm from the
 // ceiling's, went to the ceiling by size).
 // At a convex rim, where a level top seen from above meets a face that ends below it and
-// reaches further down than a stair's riser (a desk's front under its top, a cabinet's side:
-// `under_rim(top, face)`), the strip goes to the top, whichever is larger: the top's reach to
-// its edge is what a robot sets things on, and the face loses a strip of noise width. By size
+// reaches further down than a stair's riser (a desk's front under its top, a cabinet's side),
+// and at a face's foot, where a face taller than a riser stands on a level patch (its foot on
+// that patch's plane and its extent within the patch's: a cabinet's front on the floor, a
+// monitor on a desk): `keeps_strip(level, face)`, the strip goes to the level patch, whichever
+// is larger: a top's reach to its edge is what a robot sets things on, a floor's to a
+// cabinet's foot where it can drive, and the face loses a strip of noise width. By size
 // the front of a generated office's desk (seen head on, 7,500-18,000 points) took 74-290
 // points of its top in every variant of bench/planes_sweep.py's offices 51-56, and a face
-// holding one point of a table top is a false plane in an instance score of the labelled
-// surfaces.
-template <typename OnPatch, typename PastCorner, typename UnderRim>
+// holding one point of a table top or the floor is a false plane in an instance score of
+// the labelled surfaces.
+template <typename OnPatch, typename PastCorner, typename KeepsStrip>
 std::uint32_t likeliest(std::span<const Candidate> candidates, const std::vector<PointPlane>& fitted,
                         const Eigen::Vector3d& beam, OnPatch&& on_patch, PastCorner&& past_corner,
-                        UnderRim&& under_rim) {
+                        KeepsStrip&& keeps_strip) {
   if (candidates.empty()) return 0;
   const Candidate* best = &candidates[0];
   for (const Candidate& c : candidates)
@@ -216,9 +219,9 @@ std::uint32_t likeliest(std::span<const Candidate> candidates, const std::vector
         continue;
       }
     }
-    const bool under_best = under_rim(*best, c), under_c = under_rim(c, *best);
-    if (under_best != under_c) {
-      if (under_c) best = &c;
+    const bool best_keeps = keeps_strip(*best, c), c_keeps = keeps_strip(c, *best);
+    if (best_keeps != c_keeps) {
+      if (c_keeps) best = &c;
       continue;
     }
     if (fitted[c.slot].points > fitted[best->slot].points) best = &c;
