@@ -268,17 +268,16 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   //   desk against it (its foot hidden at the desk's height: PCL's room_scan2's far wall at
   //   10 cm, taken by two desk-level pieces when the extent was not asked) and from a wall
   //   over a small floor piece (3DTK's 124-point floor-class patch under a 67,000-point wall).
-  std::vector<Eigen::AlignedBox3d> box_of_slot(slots);  // empty where a patch has neither
-  std::vector<HeightRange> face_heights(slots);
-  for (std::size_t slot = 1; slot < slots; ++slot) {
-    const Plane* plane = plane_of_slot[slot];
-    if (plane == nullptr) continue;
-    Eigen::AlignedBox3d& box = box_of_slot[slot];
-    box = plane->bounds;
-    if (box.isEmpty())
-      for (const Eigen::Vector3d& corner : plane->outline) box.extend(corner);
-    if (!box.isEmpty()) face_heights[slot] = {static_cast<float>(box.min().z()), static_cast<float>(box.max().z())};
+  std::vector<Eigen::AlignedBox3d> box_of_slot(slots);  // empty where a patch has no such point
+  for (std::size_t index = 0; index < points.size(); ++index) {
+    const std::uint32_t slot = slot_of_point[index];
+    if (slot != 0 && planeDistance(fitted[slot], points[index]) <= fitted[slot].tolerance)
+      box_of_slot[slot].extend(points[index]);
   }
+  std::vector<HeightRange> face_heights(slots);
+  for (std::size_t slot = 1; slot < slots; ++slot)
+    if (!box_of_slot[slot].isEmpty())
+      face_heights[slot] = {static_cast<float>(box_of_slot[slot].min().z()), static_cast<float>(box_of_slot[slot].max().z())};
   const double riser_max = ClassifyConfig{}.riser_max;
   enum class Strip : std::uint8_t { kNone, kRim, kFoot };
   const auto stripOf = [&](std::uint32_t level_slot, std::uint32_t face, const Point& p) {
