@@ -251,8 +251,10 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   };
   // Whether the level patch `level` keeps the strip where it meets `face` (likeliest), whichever
   // is larger; `level` level and seen from above, `face` not level. Heights and extents are
-  // the patches' boxes, or their outlines' (within `level`'s tolerance and a cell, the
-  // outline's raster); never where a patch has neither.
+  // the box of a patch's points within its tolerance of its plane (compared within `level`'s
+  // tolerance and a cell); not its outline, whose raster of cells turned 45° to the grid stood
+  // 16 cm over a riser's points (the simulated corridor at 5 cm: the riser then stood on the
+  // tread below, which took 146 of its points).
   // - At a convex rim (kRim): `face` reaches no higher than `level`'s plane over the point and
   //   further below it than a stair's riser can be (a desk's front under its top). A riser
   //   keeps the rule of size: its top strip within a tread's tolerance is a fifth to a third
