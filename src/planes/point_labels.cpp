@@ -253,13 +253,11 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     return a_side * (edge.normal.dot(q) + edge.offset) > edge.tolerance / options.sigmas;
   };
   // Whether the level patch `level` keeps the strip where it meets `face` (likeliest), whichever
-  // is larger; `level` level and seen from above, `face` not level. Heights and extents are
-  // the box of a patch's points within its tolerance of its plane (compared within `level`'s
-  // tolerance and a cell); not its outline, whose raster of cells turned 45° to the grid stood
-  // 16 cm over a riser's points (the simulated corridor at 5 cm: the riser then stood on the
-  // tread below, which took 146 of its points).
+  // is larger; `level` level and seen from above, `face` not level; heights compared within
+  // `level`'s tolerance and a cell.
   // - At a convex rim (kRim): `face` reaches no higher than `level`'s plane over the point and
-  //   further below it than a stair's riser can be (a desk's front under its top). A riser
+  //   further below it than a stair's riser can be (a desk's front under its top), by its
+  //   patch's box or its outline's (session 63's measure, within the outline's raster). A riser
   //   keeps the rule of size: its top strip within a tread's tolerance is a fifth to a third
   //   of it, and the stairwell of bench/stairs_bench.py lost 9 of its 37 steps found (each
   //   tread took 10 % of a riser).
@@ -273,50 +271,16 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   //   desk against it (its foot hidden at the desk's height: PCL's room_scan2's far wall at
   //   10 cm, taken by two desk-level pieces when the extent was not asked) and from a wall
   //   over a small floor piece (3DTK's 124-point floor-class patch under a 67,000-point wall).
-  // Where each patch's points on its plane lie (within its tolerance): all of them (`reach_of_slot`:
-  // how far a level patch reaches under a face) and from the 2nd to the 98th percentile along
-  // each axis (`box_of_slot`: where a face stands): its blocks also collect strays on its plane
-  // where they meet other surfaces (a riser of the simulated corridor at 2 cm of noise: 18 of
-  // its 1,296 up to 1.9 m, on the wall beside the stair, where its points reach 0.35 m).
-  std::vector<Eigen::AlignedBox3d> box_of_slot(slots), reach_of_slot(slots);  // empty: no such point
-  {
-    std::vector<std::array<std::vector<float>, 3>> along(slots);
-    for (std::size_t index = 0; index < points.size(); ++index) {
-      const std::uint32_t slot = slot_of_point[index];
-      if (slot == 0 || !(planeDistance(fitted[slot], points[index]) <= fitted[slot].tolerance)) continue;
-      for (int axis = 0; axis < 3; ++axis) along[slot][axis].push_back(static_cast<float>(points[index][axis]));
-      reach_of_slot[slot].extend(points[index]);
-    }
-    for (std::size_t slot = 1; slot < slots; ++slot) {
-      if (along[slot][0].empty()) continue;
-      Eigen::Vector3d low, high;
-      for (int axis = 0; axis < 3; ++axis) {
-        std::vector<float>& values = along[slot][axis];
-        const auto at = [&values](double share) {
-          const auto k = static_cast<std::ptrdiff_t>(share * static_cast<double>(values.size() - 1));
-          std::nth_element(values.begin(), values.begin() + k, values.end());
-          return static_cast<double>(values[static_cast<std::size_t>(k)]);
-        };
-        low[axis] = at(kStrayShare);
-        high[axis] = at(1.0 - kStrayShare);
-      }
-      box_of_slot[slot] = Eigen::AlignedBox3d(low, high);
-    }
-  }
-  std::vector<HeightRange> outline_heights(slots);
-  for (std::size_t slot = 1; slot < slots; ++slot) {
-    const Plane* plane = plane_of_slot[slot];
-    if (plane == nullptr) continue;
-    HeightRange& range = outline_heights[slot];
-    if (!plane->bounds.isEmpty()) {
-      range = {static_cast<float>(plane->bounds.min().z()), static_cast<float>(plane->bounds.max().z())};
-    } else {
-      for (const Eigen::Vector3d& corner : plane->outline) {
-        range.low = std::min(range.low, static_cast<float>(corner.z()));
-        range.high = std::max(range.high, static_cast<float>(corner.z()));
-      }
-    }
-  }
+  //   Where the patches' points lie, not their outlines: a riser's outline, a raster of cells
+  //   turned 45° to the grid, stood 16 cm over its points (the simulated corridor at 5 cm: the
+  //   riser then stood on the tread below, which took 146 of its points).
+  // Where each patch's points on its plane lie (patchExtents), from the 2nd to the 98th
+  // percentile for a face: a riser of the simulated corridor at 2 cm of noise had 18 of its
+  // 1,296 points on its plane up to 1.9 m, on the wall beside the stair, where its points reach
+  // 0.35 m.
+  const std::vector<PatchExtent> extent_of_slot = patchExtents(points, slot_of_point, fitted, kStrayShare);
+  const std::vector<HeightRange> outline_heights = outlineHeights(plane_of_slot);
+
   const double riser_max = ClassifyConfig{}.riser_max;
   enum class Strip : std::uint8_t { kNone, kRim, kFoot };
   const auto stripOf = [&](std::uint32_t level_slot, std::uint32_t face, const Point& p) {
@@ -327,13 +291,13 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     const HeightRange& range = outline_heights[face];
     const double near = level.tolerance + reach;
     if (range.high <= height + near && range.low < height - riser_max) return Strip::kRim;
-    const Eigen::AlignedBox3d& inner = box_of_slot[face];
-    const Eigen::AlignedBox3d& outer = reach_of_slot[level_slot];
+    const Eigen::AlignedBox3d& inner = extent_of_slot[face].box;
+    const Eigen::AlignedBox3d& outer = extent_of_slot[level_slot].reach;
     if (inner.isEmpty() || outer.isEmpty()) return Strip::kNone;
     const bool within = inner.min().x() >= outer.min().x() - near &&
                         inner.min().y() >= outer.min().y() - near && inner.max().x() <= outer.max().x() + near &&
                         inner.max().y() <= outer.max().y() + near;
-    const bool stands = within && std::abs(reach_of_slot[face].min().z() - height) <= near &&
+    const bool stands = within && std::abs(extent_of_slot[face].reach.min().z() - height) <= near &&
                         inner.max().z() > height + riser_max;
     return stands ? Strip::kFoot : Strip::kNone;
   };
