@@ -70,8 +70,9 @@ std::vector<PatchExtent> patchExtents(std::span<const Point> points, std::span<c
   for (std::size_t index = 0; index < points.size(); ++index) {
     const std::uint32_t slot = slot_of_point[index];
     if (slot == 0 || !(planeDistance(fitted[slot], points[index]) <= fitted[slot].tolerance)) continue;
-    for (int axis = 0; axis < 3; ++axis) along[slot][axis].push_back(static_cast<float>(points[index][axis]));
     extent[slot].reach.extend(points[index]);
+    if (std::abs(fitted[slot].normal.z()) >= kLevelCosine) continue;  // most points, and no face
+    for (int axis = 0; axis < 3; ++axis) along[slot][axis].push_back(static_cast<float>(points[index][axis]));
   }
   for (std::size_t slot = 1; slot < slots; ++slot) {
     if (along[slot][0].empty()) continue;

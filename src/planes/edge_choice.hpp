@@ -72,9 +72,9 @@ std::vector<HeightRange> patchHeights(std::span<const Point> points, std::span<c
 std::vector<HeightRange> outlineHeights(const std::vector<const Plane*>& plane_of_slot);
 
 // Where each patch's points on its plane lie (those `slot_of_point` gives it, within its
-// tolerance): `reach`, all of them; `box`, from `stray_share` to 1 − `stray_share` of them along
-// each axis, without the strays its blocks collect on its plane where they meet other
-// surfaces. Empty boxes for a patch without such points.
+// tolerance): `reach`, all of them; `box`, for a patch that is not level (a face), from
+// `stray_share` to 1 − `stray_share` of them along each axis, without the strays its blocks
+// collect on its plane where they meet other surfaces. Empty boxes where there are none.
 struct PatchExtent {
   Eigen::AlignedBox3d box;
   Eigen::AlignedBox3d reach;
