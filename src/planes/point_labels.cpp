@@ -366,7 +366,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
         [&](const Candidate& level, const Candidate& face) {
           return stripOf(level.slot, face.slot, points[index]) != Strip::kNone;
         });
-    const std::uint32_t at_edge = chosen;
+    const std::uint32_t likeliest_choice = chosen;
     if (!beam.isZero() && found == 1)
       chosen = nearerAlongBeam(candidates[0], std::span(tail.data(), tail_found), fitted, along_tolerance,
                                kTailTolerances);
@@ -379,12 +379,13 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     // The rim's strip is the top's (likeliest) whichever rule above gave it to the face below:
     // a point within the top's tolerance of its plane (the rules for a surface's tails took
     // 2-60 points of a generated desk's top, on its plane and 1.6-2.5 cm behind the front's,
-    // to the front). Not a face's foot: there a room's inside corner decides first (likeliest),
-    // and a wall's foot, on its plane and met by the beam above the floor's, stays the wall's.
+    // to the front). A face's foot only where likeliest gave the point to the level patch and a
+    // tail rule then moved it: there a room's inside corner decides first, and a wall's foot
+    // point that the beam meets on the wall above the floor's plane stays the wall's.
     if (chosen != 0)
       for (std::size_t c = 0; c < near_found; ++c)
         if (const Strip strip = stripOf(near[c].slot, chosen, points[index]);
-            (strip == Strip::kRim || (strip == Strip::kFoot && at_edge == near[c].slot)) &&
+            (strip == Strip::kRim || (strip == Strip::kFoot && likeliest_choice == near[c].slot)) &&
             planeDistance(fitted[near[c].slot], points[index]) <= fitted[near[c].slot].tolerance) {
           chosen = near[c].slot;
           break;
