@@ -67,6 +67,16 @@ struct Scanned {
     return best;
   }
 
+  // The patches holding most of surfaces `a` and `b`: both found, and apart.
+  std::pair<std::int32_t, std::int32_t> twoPatchesOf(const std::vector<std::int32_t>& labels, std::uint8_t a,
+                                                     std::uint8_t b) const {
+    const std::int32_t first = patchOf(labels, a), second = patchOf(labels, b);
+    REQUIRE(first > 0);
+    REQUIRE(second > 0);
+    REQUIRE(first != second);
+    return {first, second};
+  }
+
   // Of a surface's points k that `pick(k)` takes, the share that carry `id`, and how many
   // were taken.
   template <typename Pick>
@@ -278,10 +288,7 @@ TEST_CASE("Point labels: a desk's top keeps its rim over a larger front face flu
   // front with ten times the top's points.
   const Rim scene(Point(2.1, 0.3, 1.2), 11, {.x0 = 1.5, .x1 = 2.7, .front = 1.6, .depth = 0.6, .height = 0.75, .floor_x1 = 4.2});
   const std::vector<std::int32_t> labels = scene.labels();
-  const std::int32_t top = scene.patchOf(labels, kRimTop), front = scene.patchOf(labels, kRimFace);
-  REQUIRE(top > 0);
-  REQUIRE(front > 0);
-  REQUIRE(top != front);
+  const auto [top, front] = scene.twoPatchesOf(labels, kRimTop, kRimFace);
   const auto [top_on_front, top_points] = scene.shareOf(labels, kRimTop, front);
   const auto [front_kept, front_points] = scene.shareOf(labels, kRimFace, front);
   MESSAGE("top points on the front's patch: " << top_on_front * top_points << " of " << top_points
@@ -299,10 +306,7 @@ TEST_CASE("Point labels: a riser under a tread's nosing keeps its top strip wher
   // low pose): the riser with more points than the tread.
   const Rim scene(Point(1.0, 0.5, 0.3), 13, {.x0 = 0.3, .x1 = 1.7, .front = 2.0, .depth = 0.28, .height = 0.17, .floor_x1 = 2.0});
   const std::vector<std::int32_t> labels = scene.labels();
-  const std::int32_t tread = scene.patchOf(labels, kRimTop), riser = scene.patchOf(labels, kRimFace);
-  REQUIRE(tread > 0);
-  REQUIRE(riser > 0);
-  REQUIRE(tread != riser);
+  const auto [tread, riser] = scene.twoPatchesOf(labels, kRimTop, kRimFace);
   const auto [kept, riser_points] = scene.shareOf(labels, kRimFace, riser);
   const auto [on_tread, all] = scene.shareOf(labels, kRimFace, tread);
   MESSAGE("riser points on its patch: " << kept * 100 << " %, on the tread's: " << on_tread * 100 << " % of " << all);
@@ -320,10 +324,7 @@ TEST_CASE("Point labels: the floor keeps its strip at the foot of a larger cabin
   const Rim scene(Point(2.0, 0.0, 1.2), 17,
                   {.x0 = 1.0, .x1 = 3.0, .front = 2.0, .depth = 0.5, .height = 1.0, .floor_x1 = 4.0, .floor_step = 0.04});
   const std::vector<std::int32_t> labels = scene.labels();
-  const std::int32_t floor = scene.patchOf(labels, kRimFloor), front = scene.patchOf(labels, kRimFace);
-  REQUIRE(floor > 0);
-  REQUIRE(front > 0);
-  REQUIRE(floor != front);
+  const auto [floor, front] = scene.twoPatchesOf(labels, kRimFloor, kRimFace);
   // The floor's points within 3 cm (its tolerance, 3 σ) in front of the face.
   const auto at_foot = [&](std::size_t k) { return scene.points[k].y() > 2.0 - 0.03; };
   const auto [foot_on_front, foot_points] = scene.shareOn(labels, kRimFloor, front, at_foot);
@@ -366,10 +367,7 @@ TEST_CASE("Point labels: a wall seen only above a desk against it does not stand
   // at 10 cm, two desk-level pieces).
   const DeskAgainstWall scene;
   const std::vector<std::int32_t> labels = scene.labels();
-  const std::int32_t desk = scene.patchOf(labels, kDeskTop), wall = scene.patchOf(labels, kBackWall);
-  REQUIRE(desk > 0);
-  REQUIRE(wall > 0);
-  REQUIRE(desk != wall);
+  const auto [desk, wall] = scene.twoPatchesOf(labels, kDeskTop, kBackWall);
   const auto [wall_on_desk, wall_points] = scene.shareOn(labels, kBackWall, desk, [](std::size_t) { return true; });
   MESSAGE("wall points on the desk's patch: " << wall_on_desk * wall_points << " of " << wall_points);
   CHECK(wall_on_desk == 0.0);
