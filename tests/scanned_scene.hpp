@@ -29,8 +29,10 @@ struct Scanned {
   MLMap map{0.05};
   PlaneDetection detection;
 
-  // `turn_deg`: the whole scene turned about z (the map's grid stays).
-  Scanned(const std::string& scene_json, const std::string& name, double turn_deg = 0.0) {
+  // `turn_deg`: the whole scene turned about z (the map's grid stays). `range_sigma` > 0: every
+  // point mapped with that range noise, as `mlmap build --range-sigma` maps scans that carry no
+  // per-point variance (the simulator's .xyz files), else with the simulator's own.
+  Scanned(const std::string& scene_json, const std::string& name, double turn_deg = 0.0, double range_sigma = 0.0) {
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(turn_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     for (const sim::SimulatedScan& simulated : sim::simulate(sim::parseScene(scene_json, name))) {
       const Scan& scan = simulated.scan;
@@ -38,7 +40,7 @@ struct Scanned {
         points.push_back(turn * scan.worldPoint(k));
         truth.push_back(scan.labels[k]);
         scanner_of_point.push_back(static_cast<std::uint32_t>(scanners.size()));
-        map.insert(points.back(), scan.variance(k));
+        map.insert(points.back(), range_sigma > 0.0 ? range_sigma * range_sigma : scan.variance(k));
       }
       scanners.push_back(turn * scan.pose.translation());
     }

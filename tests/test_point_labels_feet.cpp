@@ -70,6 +70,8 @@ TEST_CASE("Point labels: floor points at a far box side's foot go to the floor, 
   // the line. Looked for two cells round, the floor was no candidate and the face took
   // them (each such point makes the face "touch" the floor in issue 19's held-out measure);
   // looked for as far as the floor's scan lines lie apart (the detector's sparse gap) it is.
+  // Since the foot of a face on a level patch without blocks near (LevelStrips::
+  // footOnUnseenLevel) the floor keeps them looked for two cells round too: 0 either way.
   const std::string hall = test::hallScene(
       17.55, 7.22, 3.33, R"({"x": 2.41, "y": 5.27, "yaw_deg": -3.4}, {"x": 3.57, "y": 5.02, "yaw_deg": 15.2})",
       R"({"type": "box", "class": "other", "min": [8.52, 0.0, 0.0], "max": [11.07, 0.45, 0.92], "omit": ["bottom", "y-"]})");
@@ -87,7 +89,7 @@ TEST_CASE("Point labels: floor points at a far box side's foot go to the floor, 
     before_all += before.on_others;
     after_all += counted.on_others;
   }
-  CHECK(after_all < before_all);
+  CHECK(after_all <= before_all);
   CHECK(after_all <= 2);
 }
 
@@ -135,4 +137,92 @@ TEST_CASE("Point labels: halfway up a chair's back, the desk top behind it does 
   MESSAGE(back << " points of the chair's back below its top edge, " << back_on_level << " on level patches");
   REQUIRE(back > 1000);
   CHECK(back_on_level <= 5);
+}
+
+TEST_CASE("Point labels: floor points at a cabinet's foot go to the floor where its strip there is an island on no patch") {
+  // Part of bench/office_rooms.py's office-16 (held out): a cabinet 2 m tall against a wall,
+  // its front seen head on. The scanners see no floor within about a metre of themselves, so
+  // the floor before the cabinet is a strip seen from afar, cells away from the floor's
+  // patch and on no patch itself: the floor was no candidate at the foot and the front took
+  // the strip's points within its tolerance (9 here; 31-79 in every variant of office-16 in
+  // bench/planes_sweep.py, each a false plane touching the floor in issue 19's measure).
+  static const Scanned scanned(R"({"scan_pattern": {"angular_step_deg": 0.5, "tilt_start_deg": -46, "tilt_end_deg": 46, "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
+ "poses": [{"x": 6.23, "y": 1.58, "yaw_deg": 89.6}, {"x": 3.22, "y": 2.16, "yaw_deg": -171.6}, {"x": 2.0, "y": 3.24, "yaw_deg": 126.3}],
+ "surfaces": [
+  {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [7.87, 6.85, 0]},
+  {"type": "rectangle", "class": "ceiling", "min": [0, 0, 2.69], "max": [7.87, 6.85, 2.69]},
+  {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [0, 6.85, 2.69]},
+  {"type": "rectangle", "class": "wall", "min": [7.87, 0, 0], "max": [7.87, 6.85, 2.69]},
+  {"type": "rectangle", "class": "wall", "min": [0, 0, 0], "max": [7.87, 0, 2.69]},
+  {"type": "rectangle", "class": "wall", "min": [0, 6.85, 0], "max": [7.87, 6.85, 2.69]},
+  {"type": "box", "class": "other", "min": [3.25, 0.0, 0.0], "max": [5.2, 0.45, 2.06], "omit": ["bottom", "y-"]}
+ ]})", "office16_cabinet.json");
+  // The floor's points before the front (y 0.45-0.55), and how many the floor's patch's
+  // blocks collected.
+  const std::vector<std::int32_t> block_labels = scanned.blockLabels();
+  std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(block_labels, scanned.truth);
+  std::size_t strip = 0, strip_in_floor = 0;
+  for (std::size_t k = 0; k < scanned.points.size(); ++k) {
+    const Point& p = scanned.points[k];
+    if (scanned.truth[k] != 0 || p.x() < 3.3 || p.x() > 5.15 || p.y() < 0.45 || p.y() > 0.55) continue;
+    ++strip;
+    strip_in_floor += block_labels[k] > 0 && surface_of[block_labels[k]] == 0 ? 1 : 0;
+  }
+  const FloorOn counted = floorPointsOn(scanned, 6);  // the cabinet's faces
+  MESSAGE(strip << " floor points before the front, " << strip_in_floor << " in the floor's blocks; "
+                << counted.on_others << " of the floor's on the cabinet's patches");
+  REQUIRE(counted.floor > 10000);
+  REQUIRE(strip > 20);
+  REQUIRE(strip_in_floor == 0);  // the island: the case this is about
+  CHECK(counted.on_others <= 2);
+}
+
+TEST_CASE("Point labels: a desk keeps its strip at a monitor's foot where a leg below lies on the monitor's plane") {
+  // Part of bench/office_rooms.py's office-14 (held out): a monitor 0.33 m tall on a desk's
+  // top, and one of the desk's legs under the top's edge on the monitor's plane. The leg's
+  // points joined the monitor's patch through their column, so the monitor's lowest point on
+  // its plane lay at the floor: it no longer stood on the desk (the foot rule), and the
+  // monitor's patch took the desk's points within its tolerance (23 here aligned, 24 turned
+  // 10°; 127-353 in office-14's variants of bench/planes_sweep.py, each a false plane
+  // touching the desk in issue 19's measure). The foot is also where the face's points start
+  // (their 2nd percentile).
+  const std::string scene = R"({"scan_pattern": {"angular_step_deg": 0.5, "tilt_start_deg": -46, "tilt_end_deg": 46, "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
+ "poses": [{"x": 4.137, "y": 2.247, "yaw_deg": 65.845}, {"x": 6.364, "y": 1.703, "yaw_deg": -169.954}, {"x": 2.804, "y": 2.746, "yaw_deg": -134.229}],
+ "surfaces": [
+  {"class": "floor", "max": [7.3096, 6.1945, 0], "min": [0, 0, 0], "type": "rectangle"},
+  {"class": "ceiling", "max": [7.3096, 6.1945, 2.9564], "min": [0, 0, 2.9564], "type": "rectangle"},
+  {"class": "wall", "facing": "+x", "max": [0, 6.1945, 2.9564], "min": [0, 0, 0], "type": "rectangle"},
+  {"class": "wall", "facing": "-x", "max": [7.3096, 6.1945, 2.9564], "min": [7.3096, 0, 0], "type": "rectangle"},
+  {"class": "wall", "facing": "+y", "max": [7.3096, 0, 2.9564], "min": [0, 0, 0], "type": "rectangle"},
+  {"class": "wall", "facing": "-y", "max": [7.3096, 6.1945, 2.9564], "min": [0, 6.1945, 0], "type": "rectangle"},
+  {"center": [1.2104, 3.304, 0.7133], "class": "other", "classes": {"top": "table"}, "size": [1.2811, 0.7353, 0.03], "type": "box", "yaw_deg": -63.5136},
+  {"center": [0.6627, 3.6909], "radius": 0.025, "type": "cylinder", "z": [0.0, 0.6983]},
+  {"center": [1.2314, 3.9742], "radius": 0.025, "type": "cylinder", "z": [0.0, 0.6983]},
+  {"center": [1.1895, 2.6337], "radius": 0.025, "type": "cylinder", "z": [0.0, 0.6983]},
+  {"center": [1.7581, 2.9171], "radius": 0.025, "type": "cylinder", "z": [0.0, 0.6983]},
+  {"center": [1.3352, 3.5415, 0.9283], "class": "other", "size": [0.55, 0.05, 0.33], "type": "box", "yaw_deg": -67.7556}
+ ]})";
+  constexpr std::int32_t kDeskTop = 7;  // the desk box's top (its bottom is 6), at 0.728 m
+  constexpr std::int32_t kMonitor = 12;  // the monitor box's faces are 12-17
+  for (const double turn : {0.0, 10.0}) {
+    CAPTURE(turn);
+    const Scanned scanned(scene, "office14_monitor_" + std::to_string(static_cast<int>(turn)) + ".json", turn, 0.01);
+    // As `mlmap label` with the scans' poses: the noise the planes' tolerances come from is at
+    // least the one the detector assumed.
+    PointLabelRefinement options = scanned.options();
+    options.noise = labelNoiseCap(scanned.detection, true);
+    std::vector<std::int32_t> labels = scanned.blockLabels();
+    refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, options, scanned.beams());
+    std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, scanned.truth);
+    std::size_t desk = 0, desk_on_monitor = 0;
+    for (std::size_t k = 0; k < scanned.points.size(); ++k) {
+      if (scanned.truth[k] != kDeskTop) continue;
+      REQUIRE(std::abs(scanned.points[k].z() - 0.728) < 0.06);
+      ++desk;
+      desk_on_monitor += labels[k] > 0 && surface_of[labels[k]] >= kMonitor ? 1 : 0;
+    }
+    MESSAGE(turn << " deg: " << desk << " points of the desk's top, " << desk_on_monitor << " on the monitor's patches");
+    REQUIRE(desk > 500);
+    CHECK(desk_on_monitor <= 2);
+  }
 }

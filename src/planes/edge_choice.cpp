@@ -44,54 +44,6 @@ std::vector<double> alongTolerances(std::span<const Point> points, std::span<con
   return tolerance;
 }
 
-std::vector<HeightRange> outlineHeights(const std::vector<const Plane*>& plane_of_slot) {
-  std::vector<HeightRange> heights(plane_of_slot.size());
-  for (std::size_t slot = 0; slot < plane_of_slot.size(); ++slot) {
-    const Plane* plane = plane_of_slot[slot];
-    if (plane == nullptr) continue;
-    HeightRange& range = heights[slot];
-    if (!plane->bounds.isEmpty()) {
-      range = {static_cast<float>(plane->bounds.min().z()), static_cast<float>(plane->bounds.max().z())};
-      continue;
-    }
-    for (const Eigen::Vector3d& corner : plane->outline) {
-      range.low = std::min(range.low, static_cast<float>(corner.z()));
-      range.high = std::max(range.high, static_cast<float>(corner.z()));
-    }
-  }
-  return heights;
-}
-
-std::vector<PatchExtent> patchExtents(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
-                                      const std::vector<PointPlane>& fitted, double stray_share) {
-  const std::size_t slots = fitted.size();
-  std::vector<PatchExtent> extent(slots);
-  std::vector<std::array<std::vector<float>, 3>> along(slots);
-  for (std::size_t index = 0; index < points.size(); ++index) {
-    const std::uint32_t slot = slot_of_point[index];
-    if (slot == 0 || !(planeDistance(fitted[slot], points[index]) <= fitted[slot].tolerance)) continue;
-    extent[slot].reach.extend(points[index]);
-    if (std::abs(fitted[slot].normal.z()) >= kLevelCosine) continue;  // most points, and no face
-    for (int axis = 0; axis < 3; ++axis) along[slot][axis].push_back(static_cast<float>(points[index][axis]));
-  }
-  for (std::size_t slot = 1; slot < slots; ++slot) {
-    if (along[slot][0].empty()) continue;
-    Eigen::Vector3d low, high;
-    for (int axis = 0; axis < 3; ++axis) {
-      std::vector<float>& values = along[slot][axis];
-      const auto at = [&values](double share) {
-        const auto k = static_cast<std::ptrdiff_t>(share * static_cast<double>(values.size() - 1));
-        std::nth_element(values.begin(), values.begin() + k, values.end());
-        return static_cast<double>(values[static_cast<std::size_t>(k)]);
-      };
-      low[axis] = at(stray_share);
-      high[axis] = at(1.0 - stray_share);
-    }
-    extent[slot].box = Eigen::AlignedBox3d(low, high);
-  }
-  return extent;
-}
-
 std::vector<HeightRange> patchHeights(std::span<const Point> points, std::span<const std::uint32_t> sole,
                                       const std::vector<PointPlane>& fitted, double min_width) {
   const std::size_t slots = fitted.size();

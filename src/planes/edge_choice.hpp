@@ -67,21 +67,6 @@ struct HeightRange {  // m; empty (low > high) where unknown
 std::vector<HeightRange> patchHeights(std::span<const Point> points, std::span<const std::uint32_t> sole,
                                       const std::vector<PointPlane>& fitted, double min_width);
 
-// How high each patch reaches by its box (Plane::bounds), else by its outline's corners;
-// empty for a slot without a plane or with neither.
-std::vector<HeightRange> outlineHeights(const std::vector<const Plane*>& plane_of_slot);
-
-// Where each patch's points on its plane lie (those `slot_of_point` gives it, within its
-// tolerance): `reach`, all of them; `box`, for a patch that is not level (a face), from
-// `stray_share` to 1 − `stray_share` of them along each axis, without the strays its blocks
-// collect on its plane where they meet other surfaces. Empty boxes where there are none.
-struct PatchExtent {
-  Eigen::AlignedBox3d box;
-  Eigen::AlignedBox3d reach;
-};
-std::vector<PatchExtent> patchExtents(std::span<const Point> points, std::span<const std::uint32_t> slot_of_point,
-                                      const std::vector<PointPlane>& fitted, double stray_share);
-
 // How far each patch's outline reaches to either side of the refitted planes of the
 // patches round it: the least and the greatest signed distance of its vertices from the
 // other's plane, for every pair of patches whose outlines' boxes lie within `near`.

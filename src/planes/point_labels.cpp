@@ -11,6 +11,7 @@
 #include "mlmap/planes/classify.hpp"
 #include "label_fits.hpp"
 #include "label_candidates.hpp"
+#include "level_strips.hpp"
 #include "patch_sides.hpp"
 #include "mlmap/error.hpp"
 #include "pca_sums.hpp"
@@ -22,7 +23,7 @@ namespace mlmap {
 constexpr double kSurfaceTailTolerances = 4.0 / 3.0;
 constexpr double kSurfaceTailRatio = 50.0;
 // The share of a patch's points on its plane at either end of each axis left out of where
-// the patch lies (the strip rules, below).
+// the patch lies (LevelStrips).
 constexpr double kStrayShare = 0.02;
 
 std::vector<std::int32_t> labelPoints(const MLMap& map, const Scan& scan) {
@@ -252,55 +253,9 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
       return false;
     return a_side * (edge.normal.dot(q) + edge.offset) > edge.tolerance / options.sigmas;
   };
-  // Whether the level patch `level` keeps the strip where it meets `face` (likeliest), whichever
-  // is larger; `level` level and seen from above, `face` not level; heights compared within
-  // `level`'s tolerance and a cell.
-  // - At a convex rim (kRim): `face` reaches no higher than `level`'s plane over the point and
-  //   further below it than a stair's riser can be (a desk's front under its top), by its
-  //   patch's box or its outline's (session 63's measure, within the outline's raster). A riser
-  //   keeps the rule of size: its top strip within a tread's tolerance is a fifth to a third
-  //   of it, and the stairwell of bench/stairs_bench.py lost 9 of its 37 steps found (each
-  //   tread took 10 % of a riser).
-  // - At a face's foot (kFoot): `face` stands on `level`, its lowest height at `level`'s there,
-  //   its extent within `level`'s across the ground, and rises above it further than a riser (a
-  //   cabinet's front on the floor, a monitor on a desk). By size a generated office's cabinet
-  //   front seen head on (70,000 points against the floor's 27,000, seen at a grazing angle)
-  //   took 158 floor points at its foot (bench/planes_sweep.py, office-15), and a face that
-  //   touches the floor by one point is a false plane in an instance score of the labelled
-  //   surfaces. The extent tells a face standing on a patch from a wall seen only above a
-  //   desk against it (its foot hidden at the desk's height: PCL's room_scan2's far wall at
-  //   10 cm, taken by two desk-level pieces when the extent was not asked) and from a wall
-  //   over a small floor piece (3DTK's 124-point floor-class patch under a 67,000-point wall).
-  //   Where the patches' points lie, not their outlines: a riser's outline, a raster of cells
-  //   turned 45° to the grid, stood 16 cm over its points (the simulated corridor at 5 cm: the
-  //   riser then stood on the tread below, which took 146 of its points).
-  // Where each patch's points on its plane lie (patchExtents), from the 2nd to the 98th
-  // percentile for a face: a riser of the simulated corridor at 2 cm of noise had 18 of its
-  // 1,296 points on its plane up to 1.9 m, on the wall beside the stair, where its points reach
-  // 0.35 m.
-  const std::vector<PatchExtent> extent_of_slot = patchExtents(points, slot_of_point, fitted, kStrayShare);
-  const std::vector<HeightRange> outline_heights = outlineHeights(plane_of_slot);
-
-  const double riser_max = ClassifyConfig{}.riser_max;
-  enum class Strip : std::uint8_t { kNone, kRim, kFoot };
-  const auto stripOf = [&](std::uint32_t level_slot, std::uint32_t face, const Point& p) {
-    const PointPlane& level = fitted[level_slot];
-    if (std::abs(level.normal.z()) < kLevelCosine || std::abs(fitted[face].normal.z()) >= kLevelCosine) return Strip::kNone;
-    if (seen_from[level_slot] == 0 || (seen_from[level_slot] > 0) != (level.normal.z() > 0.0)) return Strip::kNone;
-    const double height = -(level.normal.x() * p.x() + level.normal.y() * p.y() + level.offset) / level.normal.z();
-    const HeightRange& range = outline_heights[face];
-    const double near = level.tolerance + reach;
-    if (range.high <= height + near && range.low < height - riser_max) return Strip::kRim;
-    const Eigen::AlignedBox3d& inner = extent_of_slot[face].box;
-    const Eigen::AlignedBox3d& outer = extent_of_slot[level_slot].reach;
-    if (inner.isEmpty() || outer.isEmpty()) return Strip::kNone;
-    const bool within = inner.min().x() >= outer.min().x() - near &&
-                        inner.min().y() >= outer.min().y() - near && inner.max().x() <= outer.max().x() + near &&
-                        inner.max().y() <= outer.max().y() + near;
-    const bool stands = within && std::abs(extent_of_slot[face].reach.min().z() - height) <= near &&
-                        inner.max().z() > height + riser_max;
-    return stands ? Strip::kFoot : Strip::kNone;
-  };
+  // Which of a level patch and a face keeps the strip where they meet (level_strips.hpp).
+  const LevelStrips strips(fitted, seen_from, patchExtents(points, slot_of_point, fitted, kStrayShare),
+                           outlineHeights(plane_of_slot), reach, ClassifyConfig{}.riser_max);
   // A point left on no patch goes back to its block's where it lies within that patch's
   // own noise (ownNoise: σ of its points within `band` of its plane), beyond the map's
   // that capped the tolerance: a wall seen far off by a depth camera lies in layers
@@ -364,7 +319,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
         [&](const Candidate& c) { return onPatch(points[index], beam, c); },
         [&](const Candidate& a, const Candidate& b) { return pastCorner(index, beam, a, b); },
         [&](const Candidate& level, const Candidate& face) {
-          return stripOf(level.slot, face.slot, points[index]) != Strip::kNone;
+          return strips.of(level.slot, face.slot, points[index]) != Strip::kNone;
         });
     const std::uint32_t likeliest_choice = chosen;
     if (!beam.isZero() && found == 1)
@@ -384,7 +339,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     // point that the beam meets on the wall above the floor's plane stays the wall's.
     if (chosen != 0)
       for (std::size_t c = 0; c < near_found; ++c)
-        if (const Strip strip = stripOf(near[c].slot, chosen, points[index]);
+        if (const Strip strip = strips.of(near[c].slot, chosen, points[index]);
             (strip == Strip::kRim || (strip == Strip::kFoot && likeliest_choice == near[c].slot)) &&
             planeDistance(fitted[near[c].slot], points[index]) <= fitted[near[c].slot].tolerance) {
           chosen = near[c].slot;
@@ -395,6 +350,8 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
         std::all_of(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(near_found),
                     [own](const Candidate& c) { return c.slot == own; }))
       chosen = own;
+    if (chosen != 0)
+      chosen = strips.footOnUnseenLevel(chosen, points[index], std::span(near.data(), near_found));
     labels[index] = chosen != 0 ? fitted[chosen].id : labels[index] < 0 ? -1 : 0;
   }
   fitted.erase(fitted.begin());  // slot 0, "none"
