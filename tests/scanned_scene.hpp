@@ -81,9 +81,10 @@ inline std::string boxRoomScene(const std::string& poses, const std::string& fur
 
 // A width x depth x height m hall (its floor, ceiling and walls are true planes 0-5) with
 // the given poses and furniture (none: empty), scanned as bench/office_rooms.py's halls are:
-// a coarser laser than boxRoomScene's (0.5 deg beams, 1 deg lines, ±46 deg), 1 cm of noise.
+// a coarser laser than boxRoomScene's (0.5 deg beams, 1 deg lines, ±46 deg), 1 cm of noise
+// (or `range_sigma` m).
 inline std::string hallScene(double width, double depth, double height, const std::string& poses,
-                             const std::string& furniture = "") {
+                             const std::string& furniture = "", double range_sigma = 0.01) {
   const auto number = [](double value) {
     std::ostringstream text;
     text << value;
@@ -92,7 +93,7 @@ inline std::string hallScene(double width, double depth, double height, const st
   const std::string w = number(width), d = number(depth), h = number(height);
   return R"({
     "scan_pattern": {"angular_step_deg": 0.5, "tilt_start_deg": -46, "tilt_end_deg": 46,
-                     "tilt_step_deg": 1.0, "range_sigma": 0.01, "mount_height": 1.2},
+                     "tilt_step_deg": 1.0, "range_sigma": )" + number(range_sigma) + R"(, "mount_height": 1.2},
     "poses": [)" + poses + R"(],
     "surfaces": [
       {"type": "rectangle", "class": "floor", "min": [0, 0, 0], "max": [)" + w + ", " + d + R"(, 0]},

@@ -58,13 +58,14 @@ std::vector<PatchExtent> patchExtents(std::span<const Point> points, std::span<c
 
 LevelStrips::LevelStrips(const std::vector<PointPlane>& fitted, const std::vector<std::int8_t>& seen_from,
                          std::vector<PatchExtent> extents, std::vector<HeightRange> outline_heights, double reach,
-                         double riser_max)
+                         double riser_max, double tail)
     : fitted_(fitted),
       seen_from_(seen_from),
       extents_(std::move(extents)),
       outline_heights_(std::move(outline_heights)),
       reach_(reach),
-      riser_max_(riser_max) {
+      riser_max_(riser_max),
+      tail_(tail) {
   for (std::size_t slot = 1; slot < fitted_.size(); ++slot)
     if (std::abs(fitted_[slot].normal.z()) >= kLevelCosine && !extents_[slot].reach.isEmpty())
       level_slots_.push_back(static_cast<std::uint32_t>(slot));
@@ -88,6 +89,14 @@ Strip LevelStrips::of(std::uint32_t level_slot, std::uint32_t face, const Point&
   return within && foot_there && inner.max().z() > height + riser_max_ ? Strip::kFoot : Strip::kNone;
 }
 
+bool LevelStrips::pastFace(std::uint32_t level, Strip strip, const Point& p) const {
+  if (strip == Strip::kNone || seen_from_[level] == 0) return false;
+  const double side = fitted_[level].normal.dot(p) + fitted_[level].offset;
+  // The face stands on the side the surface is seen from and hangs under the other.
+  const double face_side = strip == Strip::kFoot ? seen_from_[level] : -seen_from_[level];
+  return side * face_side < 0.0;
+}
+
 std::uint32_t LevelStrips::footOnUnseenLevel(std::uint32_t face, const Point& p, std::span<const Candidate> near) const {
   const PatchExtent& extent = extents_[face];
   if (std::abs(fitted_[face].normal.z()) >= kLevelCosine || extent.box.isEmpty()) return face;
@@ -96,11 +105,13 @@ std::uint32_t LevelStrips::footOnUnseenLevel(std::uint32_t face, const Point& p,
   if (p.z() < low - 3.0 * reach_ || p.z() > extent.box.min().z() + 3.0 * reach_) return face;
   for (const std::uint32_t level : level_slots_) {
     const Eigen::AlignedBox3d& ground = extents_[level].reach;
+    const double distance = planeDistance(fitted_[level], p), tolerance = fitted_[level].tolerance;
     if (p.x() < ground.min().x() - reach_ || p.x() > ground.max().x() + reach_ || p.y() < ground.min().y() - reach_ ||
-        p.y() > ground.max().y() + reach_ || planeDistance(fitted_[level], p) > fitted_[level].tolerance)
+        p.y() > ground.max().y() + reach_ || distance > tail_ * tolerance)
       continue;
     const bool candidate = std::any_of(near.begin(), near.end(), [level](const Candidate& c) { return c.slot == level; });
-    if (!candidate && of(level, face, p) == Strip::kFoot) return level;
+    if (candidate || of(level, face, p) != Strip::kFoot) continue;
+    if (distance <= tolerance || pastFace(level, Strip::kFoot, p)) return level;
   }
   return face;
 }

@@ -1,6 +1,7 @@
 // Whether the smaller of two pieces may be part of the larger's surface (piece_tests.hpp).
 #include "piece_tests.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -92,8 +93,13 @@ double seamApart(const BlockGrid& grid, const PatchSet& set, std::size_t smaller
   return distances.empty() ? std::numeric_limits<double>::infinity() : medianOf(distances);
 }
 
-bool withinSheet(const PointMoments& piece, const Plane& larger, const Eigen::Vector3d& origin, double noise) {
+bool withinSheet(const PointMoments& piece, const Plane& larger, const Eigen::Vector3d& origin, double noise,
+                 double width) {
   if (piece.count < 3.0) return false;
+  // Narrow: the spread across its length (the middle axis of its points) within `width`.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(piece.covariance(), Eigen::EigenvaluesOnly);
+  if (std::sqrt(std::max(0.0, solver.eigenvalues()(1))) > width) return false;
   const double offset = larger.offset + larger.normal.dot(origin);
   const double mean_square = larger.normal.dot(piece.outer * larger.normal) / piece.count +
                              2.0 * offset * larger.normal.dot(piece.mean()) + offset * offset;

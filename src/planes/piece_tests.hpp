@@ -35,6 +35,10 @@ double seamApart(const BlockGrid& grid, const PatchSet& set, std::size_t smaller
 // within a tread's sheet where the tread's edge blocks hold them) stays apart: the simulated
 // stair at 10 cm cells (tests/test_planes_stairs.cpp) gave a tread its riser's 12 blocks.
 constexpr double kMaxLeanCosine = 0.7071;
+// And only a strip of a surface a tenth its size or less: a fan across a ceiling is 1-2 % of
+// it (hall-4: 71-91 blocks against 4,054). Two faces of a chair 27° apart, 11 and 42 blocks,
+// joined and the joint face then took a desk's points (bench/planes_sweep.py, office-67).
+constexpr std::size_t kStripShare = 10;
 
 // Whether a piece's points lie about the larger's plane within a sheet's step (mergeCoplanar's
 // test for layers of one surface), whatever the piece's own fit says: a piece too narrow
@@ -43,7 +47,12 @@ constexpr double kMaxLeanCosine = 0.7071;
 // or two cells wide fits the fan's plane exactly (RMS 0) and leans 16-20° off the ceiling
 // whose points it is (bench/planes_sweep.py's held-out hall-4 with 3 cm of range noise at
 // 5 cm cells: four such patches of 71-91 points, each a false plane on the ceiling).
+// Only a strip: the RMS spread of its points across its length within `width` (a cell; a
+// strip up to 3.5 cells wide). Two small faces of different things side by side, 15° apart
+// and each a few cells across (a chair's back by a monitor), lie within a sheet's step of
+// each other's planes at 3 cm of noise, and joined (bench/planes_sweep.py, office-72).
 // `piece`: its points' moments about `origin` (patchMoments).
-bool withinSheet(const PointMoments& piece, const Plane& larger, const Eigen::Vector3d& origin, double noise);
+bool withinSheet(const PointMoments& piece, const Plane& larger, const Eigen::Vector3d& origin, double noise,
+                 double width);
 
 }  // namespace mlmap

@@ -255,7 +255,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
   };
   // Which of a level patch and a face keeps the strip where they meet (level_strips.hpp).
   const LevelStrips strips(fitted, seen_from, patchExtents(points, slot_of_point, fitted, kStrayShare),
-                           outlineHeights(plane_of_slot), reach, ClassifyConfig{}.riser_max);
+                           outlineHeights(plane_of_slot), reach, ClassifyConfig{}.riser_max, kTailTolerances);
   // A point left on no patch goes back to its block's where it lies within that patch's
   // own noise (ownNoise: σ of its points within `band` of its plane), beyond the map's
   // that capped the tolerance: a wall seen far off by a depth camera lies in layers
@@ -336,15 +336,19 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
     // 2-60 points of a generated desk's top, on its plane and 1.6-2.5 cm behind the front's,
     // to the front). A face's foot only where likeliest gave the point to the level patch and a
     // tail rule then moved it: there a room's inside corner decides first, and a wall's foot
-    // point that the beam meets on the wall above the floor's plane stays the wall's.
+    // point that the beam meets on the wall above the floor's plane stays the wall's. And a
+    // point past the face's end across the level patch's plane (pastFace) is that patch's tail.
     if (chosen != 0)
-      for (std::size_t c = 0; c < near_found; ++c)
-        if (const Strip strip = strips.of(near[c].slot, chosen, points[index]);
-            (strip == Strip::kRim || (strip == Strip::kFoot && likeliest_choice == near[c].slot)) &&
-            planeDistance(fitted[near[c].slot], points[index]) <= fitted[near[c].slot].tolerance) {
-          chosen = near[c].slot;
+      for (std::size_t c = 0; c < near_found; ++c) {
+        const std::uint32_t level = near[c].slot;
+        const Strip strip = strips.of(level, chosen, points[index]);
+        if (strip == Strip::kNone) continue;
+        const bool on_plane = planeDistance(fitted[level], points[index]) <= fitted[level].tolerance;
+        if ((on_plane && (strip == Strip::kRim || likeliest_choice == level)) || strips.pastFace(level, strip, points[index])) {
+          chosen = level;
           break;
         }
+      }
     const std::uint32_t own = slot_of_point[index];
     if (chosen == 0 && own != 0 && planeDistance(fitted[own], points[index]) <= options.sigmas * own_noise[own] &&
         std::all_of(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(near_found),
