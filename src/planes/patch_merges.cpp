@@ -58,14 +58,14 @@ void mergeGroups(const BlockGrid& grid, PatchSet& set, const std::vector<std::si
         if (roots[member] == k && set.blocks[member].size() > set.blocks[largest_member].size()) largest_member = member;
       const bool root_leans =
           std::abs(planes[k].normal.dot(planes[largest_member].normal)) < std::cos(0.5 * kappa_rad);
-      const Plane& largest = planes[root_leans ? largest_member : k];
-      const CandidatePlane reference{largest.normal.cast<float>(), largest.centroid.cast<float>()};
+      const Plane& described_on = planes[root_leans ? largest_member : k];
+      const CandidatePlane reference{described_on.normal.cast<float>(), described_on.centroid.cast<float>()};
       patch.surface = surfaceOf(grid, patch.blocks);
-      frame = OutlineFrame{largest.normal, largest.centroid, true};
+      frame = OutlineFrame{described_on.normal, described_on.centroid, true};
       plane = describePatch(grid, patch, reference, kappa_rad, noise);
-      plane.source = largest.source;
-      plane.candidates = largest.candidates;
-      plane.label = largest.label;
+      plane.source = described_on.source;
+      plane.candidates = described_on.candidates;
+      plane.label = described_on.label;
     }
     plane.id = static_cast<std::int32_t>(merged.size() + 1);
     for (std::size_t member = 0; member < count; ++member) {
