@@ -97,12 +97,16 @@ bool LevelStrips::pastFace(std::uint32_t level, Strip strip, const Point& p) con
   return side * face_side < 0.0;
 }
 
-std::uint32_t LevelStrips::footOnUnseenLevel(std::uint32_t face, const Point& p, std::span<const Candidate> near) const {
+std::uint32_t LevelStrips::stripOnUnseenLevel(std::uint32_t face, const Point& p, std::span<const Candidate> near) const {
   const PatchExtent& extent = extents_[face];
   if (std::abs(fitted_[face].normal.z()) >= kLevelCosine || extent.box.isEmpty()) return face;
-  // Only near the face's foot (by either measure of of()), a few cells round.
+  // Only near the face's foot (by either measure of of()) or its top, a few cells round.
   const double low = std::min(extent.reach.min().z(), extent.box.min().z());
-  if (p.z() < low - 3.0 * reach_ || p.z() > extent.box.min().z() + 3.0 * reach_) return face;
+  const bool at_foot = p.z() >= low - 3.0 * reach_ && p.z() <= extent.box.min().z() + 3.0 * reach_;
+  const HeightRange& range = outline_heights_[face];
+  const bool at_top = p.z() >= extent.box.max().z() - 3.0 * reach_ &&
+                      p.z() <= std::max<double>(extent.box.max().z(), range.high) + 3.0 * reach_;
+  if (!at_foot && !at_top) return face;
   for (const std::uint32_t level : level_slots_) {
     const Eigen::AlignedBox3d& ground = extents_[level].reach;
     const double distance = planeDistance(fitted_[level], p), tolerance = fitted_[level].tolerance;
@@ -110,8 +114,9 @@ std::uint32_t LevelStrips::footOnUnseenLevel(std::uint32_t face, const Point& p,
         p.y() > ground.max().y() + reach_ || distance > tail_ * tolerance)
       continue;
     const bool candidate = std::any_of(near.begin(), near.end(), [level](const Candidate& c) { return c.slot == level; });
-    if (candidate || of(level, face, p) != Strip::kFoot) continue;
-    if (distance <= tolerance || pastFace(level, Strip::kFoot, p)) return level;
+    const Strip strip = candidate ? Strip::kNone : of(level, face, p);
+    if (strip == Strip::kNone) continue;
+    if (distance <= tolerance || pastFace(level, strip, p)) return level;
   }
   return face;
 }

@@ -355,7 +355,7 @@ std::vector<PointPlane> refinePointLabels(const MLMap& map, std::span<const Plan
                     [own](const Candidate& c) { return c.slot == own; }))
       chosen = own;
     if (chosen != 0)
-      chosen = strips.footOnUnseenLevel(chosen, points[index], std::span(near.data(), near_found));
+      chosen = strips.stripOnUnseenLevel(chosen, points[index], std::span(near.data(), near_found));
     labels[index] = chosen != 0 ? fitted[chosen].id : labels[index] < 0 ? -1 : 0;
   }
   fitted.erase(fitted.begin());  // slot 0, "none"
