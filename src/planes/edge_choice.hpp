@@ -5,7 +5,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
 #include <functional>

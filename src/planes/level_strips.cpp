@@ -7,6 +7,15 @@
 #include <utility>
 
 namespace mlmap {
+namespace {
+
+// Whether `inner` lies within `outer` across the ground (x and y), `margin` round it.
+bool withinAcross(const Eigen::AlignedBox3d& inner, const Eigen::AlignedBox3d& outer, double margin) {
+  return inner.min().x() >= outer.min().x() - margin && inner.min().y() >= outer.min().y() - margin &&
+         inner.max().x() <= outer.max().x() + margin && inner.max().y() <= outer.max().y() + margin;
+}
+
+}  // namespace
 
 std::vector<HeightRange> outlineHeights(const std::vector<const Plane*>& plane_of_slot) {
   std::vector<HeightRange> heights(plane_of_slot.size());
@@ -82,8 +91,7 @@ Strip LevelStrips::of(std::uint32_t level_slot, std::uint32_t face, const Point&
   const Eigen::AlignedBox3d& inner = extents_[face].box;
   const Eigen::AlignedBox3d& outer = extents_[level_slot].reach;
   if (inner.isEmpty() || outer.isEmpty()) return Strip::kNone;
-  const bool within = inner.min().x() >= outer.min().x() - near && inner.min().y() >= outer.min().y() - near &&
-                      inner.max().x() <= outer.max().x() + near && inner.max().y() <= outer.max().y() + near;
+  const bool within = withinAcross(inner, outer, near);
   const bool foot_there = std::abs(extents_[face].reach.min().z() - height) <= near ||
                           std::abs(inner.min().z() - height) <= near;
   return within && foot_there && inner.max().z() > height + riser_max_ ? Strip::kFoot : Strip::kNone;
@@ -110,9 +118,7 @@ std::uint32_t LevelStrips::stripOnUnseenLevel(std::uint32_t face, const Point& p
   for (const std::uint32_t level : level_slots_) {
     const Eigen::AlignedBox3d& ground = extents_[level].reach;
     const double distance = planeDistance(fitted_[level], p), tolerance = fitted_[level].tolerance;
-    if (p.x() < ground.min().x() - reach_ || p.x() > ground.max().x() + reach_ || p.y() < ground.min().y() - reach_ ||
-        p.y() > ground.max().y() + reach_ || distance > tail_ * tolerance)
-      continue;
+    if (!withinAcross(Eigen::AlignedBox3d(p, p), ground, reach_) || distance > tail_ * tolerance) continue;
     const bool candidate = std::any_of(near.begin(), near.end(), [level](const Candidate& c) { return c.slot == level; });
     const Strip strip = candidate ? Strip::kNone : of(level, face, p);
     if (strip == Strip::kNone) continue;

@@ -268,8 +268,7 @@ void mergeCoplanar(const BlockGrid& grid, PatchSet& set, double epsilon, double 
       if (touching && noise > 0.0) {
         const auto oneSurface = [&](const PointMoments& one, const PointMoments& other, double own) {
           const std::optional<double> joint = planeRms(sum(one, other));
-          const double half_step = 1.5 * std::numbers::sqrt2 * std::max(noise, own);
-          return !joint || *joint <= std::hypot(own, half_step);
+          return !joint || *joint <= oneSurfaceRms(noise, own);
         };
         touching = oneSurface(momentsOf(a), momentsOf(b), std::max(first.rms, second.rms));
         // The same test on the groups the two already joined: pairwise, a small rough piece

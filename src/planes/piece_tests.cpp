@@ -93,6 +93,10 @@ double seamApart(const BlockGrid& grid, const PatchSet& set, std::size_t smaller
   return distances.empty() ? std::numeric_limits<double>::infinity() : medianOf(distances);
 }
 
+double oneSurfaceRms(double noise, double own) {
+  return std::hypot(own, 1.5 * std::numbers::sqrt2 * std::max(noise, own));
+}
+
 bool withinSheet(const PointMoments& piece, const Plane& larger, const Eigen::Vector3d& origin, double noise,
                  double width) {
   if (piece.count < 3.0) return false;
@@ -103,8 +107,7 @@ bool withinSheet(const PointMoments& piece, const Plane& larger, const Eigen::Ve
   const double offset = larger.offset + larger.normal.dot(origin);
   const double mean_square = larger.normal.dot(piece.outer * larger.normal) / piece.count +
                              2.0 * offset * larger.normal.dot(piece.mean()) + offset * offset;
-  const double half_step = 1.5 * std::numbers::sqrt2 * std::max(noise, larger.rms);
-  return std::sqrt(std::max(0.0, mean_square)) <= std::hypot(larger.rms, half_step);
+  return std::sqrt(std::max(0.0, mean_square)) <= oneSurfaceRms(noise, larger.rms);
 }
 
 }  // namespace mlmap

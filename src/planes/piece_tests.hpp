@@ -29,6 +29,12 @@ bool isSparseTail(const BlockGrid& grid, const PatchSet& set, std::size_t smalle
 // plane is then the sheet test's to say (mergeCoplanar).
 double seamApart(const BlockGrid& grid, const PatchSet& set, std::size_t smaller, const Plane& larger, int radius);
 
+// The largest RMS about one plane that the points of two layers of one surface can show: their
+// own RMS `own`, and a sheet's step (3 √2 σ, sheets.hpp) between them, of which the joint plane
+// lies half either way; σ the map's `noise`, or `own` where that is larger (mergeCoplanar says
+// what it was measured on).
+double oneSurfaceRms(double noise, double own);
+
 // How far a piece may lean from the larger for withinSheet to ask (45°): a fan leans by the
 // scanner's height under the surface over its distance, and where that is steep the lines
 // lie close and are no strips of their own. A riser's piece beside a tread (90°, its points
