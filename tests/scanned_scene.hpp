@@ -52,12 +52,25 @@ struct Scanned {
                                 .band = detection.config.epsilon + 0.5 * map.cellSize(),
                                 .level_gap = detection.config.sparse_gap};
   }
+  // As `mlmap label` with the scans' poses: the noise the planes' tolerances come from is at
+  // least the one the detector assumed (labelNoiseCap).
+  PointLabelRefinement labelOptions() const {
+    PointLabelRefinement refinement = options();
+    refinement.noise = labelNoiseCap(detection, true);
+    return refinement;
+  }
   BeamOrigins beams() const { return BeamOrigins{scanners, scanner_of_point}; }
   // Each point's collecting block's label (labelPoints).
   std::vector<std::int32_t> blockLabels() const {
     Scan all;
     all.points = points;
     return labelPoints(map, all);
+  }
+  // Each point's label refined with its scanner's beam (refinePointLabels).
+  std::vector<std::int32_t> pointLabels(const PointLabelRefinement& refinement) const {
+    std::vector<std::int32_t> labels = blockLabels();
+    refinePointLabels(map, detection.planes, points, labels, refinement, beams());
+    return labels;
   }
 };
 
@@ -123,9 +136,7 @@ struct FloorOn {
 
 inline FloorOn floorPointsOn(const Scanned& scanned, std::int32_t first_surface,
                       const std::optional<PointLabelRefinement>& options = std::nullopt) {
-  std::vector<std::int32_t> labels = scanned.blockLabels();
-  refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, options.value_or(scanned.options()),
-                    scanned.beams());
+  const std::vector<std::int32_t> labels = scanned.pointLabels(options.value_or(scanned.options()));
   std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, scanned.truth);
   FloorOn counted;
   for (std::size_t k = 0; k < scanned.points.size(); ++k) {

@@ -239,8 +239,7 @@ TEST_CASE("Point labels: at the foot of a cabinet and above its side, the floor'
   const Scanned& scanned = cabinetRoom();
   const std::vector<Point>& points = scanned.points;
   const std::vector<std::int32_t>& truth = scanned.truth;
-  std::vector<std::int32_t> labels = scanned.blockLabels();
-  refinePointLabels(scanned.map, scanned.detection.planes, points, labels, scanned.options(), scanned.beams());
+  const std::vector<std::int32_t> labels = scanned.pointLabels(scanned.options());
   std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, truth);
   // The room's own surfaces are planes 0-5; their points on a patch of the furniture's.
   std::size_t room = 0, taken = 0, swapped = 0;
@@ -339,8 +338,7 @@ TEST_CASE("Point labels: a room surface's points past its plane from the scanner
   // held-out measure: the simulated lab at 10 cm, 2 of its 11 false patches). Nothing
   // but the surface itself lies past it: the furniture's patches end there.
   const Scanned& scanned = cabinetRoom();
-  std::vector<std::int32_t> labels = scanned.blockLabels();
-  refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, scanned.options(), scanned.beams());
+  const std::vector<std::int32_t> labels = scanned.pointLabels(scanned.options());
   std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, scanned.truth);
   // The room's surfaces (true planes 0-5) are axis-aligned: floor z = 0, ceiling z = 2.8,
   // walls x = 0 and 6, y = 0 and 5.

@@ -119,8 +119,7 @@ TEST_CASE("Point labels: halfway up a chair's back, the desk top behind it does 
   {"type": "box", "class": "other", "center": [2.9008, 1.843, 0.7963], "size": [0.44, 0.04, 0.42], "yaw_deg": 50.15},
   {"type": "cylinder", "center": [2.7089, 2.0032], "radius": 0.03, "z": [0.05, 0.4363]}
  ]})", "office23_chair.json");
-  std::vector<std::int32_t> labels = scanned.blockLabels();
-  refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, scanned.options(), scanned.beams());
+  const std::vector<std::int32_t> labels = scanned.pointLabels(scanned.options());
   std::map<std::int32_t, bool> level;
   for (const Plane& plane : scanned.detection.planes) level[plane.id] = std::abs(plane.normal.z()) > 0.966;
   // The back's points: within 2 cm of its box, below its top edge.
@@ -193,12 +192,7 @@ TEST_CASE("Point labels: a desk keeps its strip at a monitor's foot where a leg 
   for (const double turn : {0.0, 10.0}) {
     CAPTURE(turn);
     const Scanned scanned(scene, "office14_monitor_" + std::to_string(static_cast<int>(turn)) + ".json", turn, 0.01);
-    // As `mlmap label` with the scans' poses: the noise the planes' tolerances come from is at
-    // least the one the detector assumed.
-    PointLabelRefinement options = scanned.options();
-    options.noise = labelNoiseCap(scanned.detection, true);
-    std::vector<std::int32_t> labels = scanned.blockLabels();
-    refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, options, scanned.beams());
+    const std::vector<std::int32_t> labels = scanned.pointLabels(scanned.labelOptions());
     std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, scanned.truth);
     std::size_t desk = 0, desk_on_monitor = 0;
     for (std::size_t k = 0; k < scanned.points.size(); ++k) {
@@ -228,9 +222,7 @@ TEST_CASE("Point labels: floor points below the floor's plane at a cabinet's foo
   for (const double turn : {0.0, 5.0, 10.0, 20.0, 30.0}) {
     CAPTURE(turn);
     const Scanned scanned(scene, "office15_cabinet_" + std::to_string(static_cast<int>(turn)) + ".json", turn, 0.03);
-    PointLabelRefinement options = scanned.options();  // as `mlmap label` with the scans' poses
-    options.noise = labelNoiseCap(scanned.detection, true);
-    const FloorOn counted = floorPointsOn(scanned, 6, options);  // the cabinet's faces
+    const FloorOn counted = floorPointsOn(scanned, 6, scanned.labelOptions());  // the cabinet's faces
     MESSAGE(turn << " deg: " << counted.floor << " floor points, " << counted.on_others << " on the cabinet's patches");
     REQUIRE(counted.floor > 3000);
     floor_on_faces += counted.on_others;
@@ -257,10 +249,7 @@ TEST_CASE("Point labels: a narrow top keeps its rim where the front's noise fill
   finer(R"("angular_step_deg": 0.5)", R"("angular_step_deg": 0.25)");
   finer(R"("tilt_step_deg": 1.0)", R"("tilt_step_deg": 0.4)");
   const Scanned scanned(scene, "office72_sideboard.json", 0.0, 0.03);
-  PointLabelRefinement options = scanned.options();  // as `mlmap label` with the scans' poses
-  options.noise = labelNoiseCap(scanned.detection, true);
-  std::vector<std::int32_t> labels = scanned.blockLabels();
-  refinePointLabels(scanned.map, scanned.detection.planes, scanned.points, labels, options, scanned.beams());
+  const std::vector<std::int32_t> labels = scanned.pointLabels(scanned.labelOptions());
   std::map<std::int32_t, std::int32_t> surface_of = surfaceOfPatches(labels, scanned.truth);
   constexpr std::int32_t kTop = 6, kFront = 9;  // the sideboard's top (it has no bottom) and its y+ face
   std::size_t top = 0, top_on_front = 0;
